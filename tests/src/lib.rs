@@ -1,0 +1,1 @@
+//! Cross-crate closed-loop tests live in `tests/tests/`.
