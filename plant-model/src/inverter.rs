@@ -1,0 +1,76 @@
+//! Two-level voltage-source inverter, average model over one PWM period, with the optional
+//! dead-time voltage error of Section 4.1 (2).
+//!
+//! Each leg's average pole voltage is d_x·U_dc. During the dead time both switches of a leg
+//! are off and the phase current free-wheels through a diode: a positive (motor-bound)
+//! current through the lower diode, a negative one through the upper. Each PWM period has
+//! two such intervals, so the average pole voltage loses t_d·f_pwm·U_dc·sign(i_x). The
+//! sign fades linearly within a small current band: there the ripple current reverses within
+//! the period and the error shrinks. The motor sees the pole voltages less their mean (the
+//! star point floats), transformed to d-q with the amplitude-invariant Clarke and Park
+//! transforms.
+
+use crate::rig::InverterParams;
+
+const SQRT3: f64 = 1.732_050_807_568_877_2;
+
+/// Inverter equations with precomputed constants.
+#[derive(Clone, Debug)]
+pub struct Inverter {
+    /// U_dc. [V]
+    pub u_dc_v: f64,
+    /// Dead-time voltage error at full current, t_d·f_pwm·U_dc. [V]
+    dead_time_error_v: f64,
+    /// Current band of the dead-time sign. [A]
+    band_a: f64,
+}
+
+impl Inverter {
+    /// From validated parameters.
+    pub fn new(p: &InverterParams) -> Inverter {
+        Inverter {
+            u_dc_v: p.u_dc_v,
+            dead_time_error_v: 2.0 * p.dead_time_s * p.pwm_frequency_hz * p.u_dc_v,
+            band_a: p.dead_time_current_band_a,
+        }
+    }
+
+    /// Average pole voltages (against the negative rail) for `duties` and phase currents
+    /// `i_abc` (positive into the motor). [V]
+    #[inline]
+    pub fn pole_voltages(&self, duties: &[f64; 3], i_abc: &[f64; 3]) -> [f64; 3] {
+        let mut v = [0.0; 3];
+        for ((v, d), i) in v.iter_mut().zip(duties).zip(i_abc) {
+            let err = if self.dead_time_error_v > 0.0 {
+                self.dead_time_error_v * (i / self.band_a).clamp(-1.0, 1.0)
+            } else {
+                0.0
+            };
+            *v = d * self.u_dc_v - err;
+        }
+        v
+    }
+}
+
+/// Phase (star) voltages from pole voltages, to d-q at the given sin/cos of θ_e. [V]
+#[inline]
+pub fn pole_to_dq(v_pole: &[f64; 3], sin_e: f64, cos_e: f64) -> (f64, f64) {
+    let mean = (v_pole[0] + v_pole[1] + v_pole[2]) / 3.0;
+    let va = v_pole[0] - mean;
+    let (vb, vc) = (v_pole[1] - mean, v_pole[2] - mean);
+    let alpha = va;
+    let beta = (vb - vc) / SQRT3;
+    (alpha * cos_e + beta * sin_e, -alpha * sin_e + beta * cos_e)
+}
+
+/// Phase currents from d-q currents at the given sin/cos of θ_e. [A]
+#[inline]
+pub fn dq_to_abc(i_d: f64, i_q: f64, sin_e: f64, cos_e: f64) -> [f64; 3] {
+    let alpha = i_d * cos_e - i_q * sin_e;
+    let beta = i_d * sin_e + i_q * cos_e;
+    [
+        alpha,
+        -0.5 * alpha + 0.5 * SQRT3 * beta,
+        -0.5 * alpha - 0.5 * SQRT3 * beta,
+    ]
+}

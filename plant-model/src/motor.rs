@@ -1,0 +1,195 @@
+//! PMSM in the rotor d-q frame (amplitude-invariant), eq. 1–7, with the low-speed torque
+//! disturbances of Section 4.1: cogging torque (eq. 16) and magnet-flux harmonics
+//! (eq. 17–19).
+//!
+//! Flux linkage ψ_d = L_d·i_d + ψ_df(θ_e), ψ_q = L_q·i_q + ψ_qf(θ_e) (eq. 1, generalised): the
+//! magnet flux seen in d-q is ψ_f plus the Park transform of the phase harmonics of eq. 17.
+//! A harmonic of order k = 6j+1 in the phases is a positive sequence and appears at
+//! (k−1)·θ_e in d-q; k = 6j−1 is a negative sequence and appears at (k+1)·θ_e — so the 5th
+//! and 7th both give the 6th, the 11th and 13th the 12th (eq. 18). Voltage (eq. 2):
+//!
+//! ```text
+//! L_d·di_d/dt = u_d − R_s·i_d − ω_e·∂ψ_df/∂θ_e + ω_e·(L_q·i_q + ψ_qf)
+//! L_q·di_q/dt = u_q − R_s·i_q − ω_e·∂ψ_qf/∂θ_e − ω_e·(L_d·i_d + ψ_df)
+//! ```
+//!
+//! Torque from the power balance (electrical power in = d/dt of the winding energy
+//! ¾(L_d·i_d² + L_q·i_q²) + copper loss + T_e·ω_m), which is eq. 3 plus the harmonic terms:
+//!
+//! ```text
+//! T_e = 1.5·p_n·[ψ_df·i_q − ψ_qf·i_d + i_d·∂ψ_df/∂θ_e + i_q·∂ψ_qf/∂θ_e + (L_d − L_q)·i_d·i_q]
+//! ```
+//!
+//! With i_d = 0 and the 5th and 7th at the same phase φ this is
+//! T_e = 1.5·p_n·i_q·[ψ_f + (7ψ_7 − 5ψ_5)·cos(6θ_e + φ)] (eq. 19's T_0 + T_6·cos 6θ_e).
+//! Cogging (eq. 16) is a conservative torque −dW/dθ_m from the slotting energy W(θ_m).
+
+use crate::rig::{MotorParams, MAX_COGGING_HARMONICS, MAX_FLUX_HARMONICS};
+
+/// One flux harmonic as it appears in d-q: ψ_df += a·cos(m·θ_e + φ), ψ_qf += s·a·sin(m·θ_e + φ).
+#[derive(Clone, Copy, Debug)]
+struct DqFluxTerm {
+    amplitude_wb: f64,
+    multiple: f64,
+    sequence: f64,
+    phase_rad: f64,
+}
+
+/// The magnet flux in d-q at one rotor angle, with its angular derivatives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagnetFlux {
+    /// ψ_df. [Wb]
+    pub d_wb: f64,
+    /// ψ_qf. [Wb]
+    pub q_wb: f64,
+    /// ∂ψ_df/∂θ_e. [Wb/rad]
+    pub d_slope_wb: f64,
+    /// ∂ψ_qf/∂θ_e. [Wb/rad]
+    pub q_slope_wb: f64,
+}
+
+/// The motor's equations, precomputed from [`MotorParams`] (only active harmonics kept).
+#[derive(Clone, Debug)]
+pub struct Motor {
+    /// Pole pairs p_n as a float. [1]
+    pub pole_pairs: f64,
+    /// R_s. [Ω]
+    pub r_s_ohm: f64,
+    /// L_d. [H]
+    pub l_d_h: f64,
+    /// L_q. [H]
+    pub l_q_h: f64,
+    /// ψ_f. [Wb]
+    pub psi_f_wb: f64,
+    flux_terms: [DqFluxTerm; MAX_FLUX_HARMONICS],
+    n_flux_terms: usize,
+    cogging: [(f64, f64, f64); MAX_COGGING_HARMONICS],
+    n_cogging: usize,
+}
+
+impl Motor {
+    /// Builds the equations from validated parameters.
+    pub fn new(p: &MotorParams) -> Motor {
+        let empty = DqFluxTerm {
+            amplitude_wb: 0.0,
+            multiple: 0.0,
+            sequence: 0.0,
+            phase_rad: 0.0,
+        };
+        let mut flux_terms = [empty; MAX_FLUX_HARMONICS];
+        let mut n_flux_terms = 0;
+        for h in p.flux_harmonics.iter().filter(|h| h.amplitude_wb != 0.0) {
+            // 6j+1: positive sequence, seen at (k−1)·θ_e; 6j−1: negative, at (k+1)·θ_e.
+            let (multiple, sequence) = if h.order % 6 == 1 {
+                (h.order - 1, 1.0)
+            } else {
+                (h.order + 1, -1.0)
+            };
+            flux_terms[n_flux_terms] = DqFluxTerm {
+                amplitude_wb: h.amplitude_wb,
+                multiple: multiple as f64,
+                sequence,
+                phase_rad: h.phase_rad,
+            };
+            n_flux_terms += 1;
+        }
+        let mut cogging = [(0.0, 0.0, 0.0); MAX_COGGING_HARMONICS];
+        let mut n_cogging = 0;
+        for c in p.cogging.iter().filter(|c| c.amplitude_nm > 0.0) {
+            cogging[n_cogging] = (c.amplitude_nm, c.order as f64, c.phase_rad);
+            n_cogging += 1;
+        }
+        Motor {
+            pole_pairs: p.pole_pairs as f64,
+            r_s_ohm: p.r_s_ohm,
+            l_d_h: p.l_d_h,
+            l_q_h: p.l_q_h,
+            psi_f_wb: p.psi_f_wb,
+            flux_terms,
+            n_flux_terms,
+            cogging,
+            n_cogging,
+        }
+    }
+
+    /// Magnet flux in d-q at electrical angle `theta_e` (eq. 18).
+    #[inline]
+    pub fn magnet_flux(&self, theta_e: f64) -> MagnetFlux {
+        let mut f = MagnetFlux {
+            d_wb: self.psi_f_wb,
+            q_wb: 0.0,
+            d_slope_wb: 0.0,
+            q_slope_wb: 0.0,
+        };
+        for t in self.flux_terms.iter().take(self.n_flux_terms) {
+            let arg = t.multiple * theta_e + t.phase_rad;
+            let (s, c) = (libm::sin(arg), libm::cos(arg));
+            f.d_wb += t.amplitude_wb * c;
+            f.q_wb += t.sequence * t.amplitude_wb * s;
+            f.d_slope_wb -= t.multiple * t.amplitude_wb * s;
+            f.q_slope_wb += t.sequence * t.multiple * t.amplitude_wb * c;
+        }
+        f
+    }
+
+    /// Electromagnetic torque (eq. 3 with the flux harmonics). [N·m]
+    #[inline]
+    pub fn torque_nm(&self, i_d: f64, i_q: f64, flux: &MagnetFlux) -> f64 {
+        1.5 * self.pole_pairs
+            * (flux.d_wb * i_q - flux.q_wb * i_d
+                + i_d * flux.d_slope_wb
+                + i_q * flux.q_slope_wb
+                + (self.l_d_h - self.l_q_h) * i_d * i_q)
+    }
+
+    /// di_d/dt and di_q/dt (eq. 2 with the harmonic back-EMF). [A/s]
+    #[inline]
+    pub fn current_derivatives(
+        &self,
+        u_d: f64,
+        u_q: f64,
+        i_d: f64,
+        i_q: f64,
+        omega_e: f64,
+        flux: &MagnetFlux,
+    ) -> (f64, f64) {
+        let did = (u_d - self.r_s_ohm * i_d - omega_e * flux.d_slope_wb
+            + omega_e * (self.l_q_h * i_q + flux.q_wb))
+            / self.l_d_h;
+        let diq = (u_q
+            - self.r_s_ohm * i_q
+            - omega_e * flux.q_slope_wb
+            - omega_e * (self.l_d_h * i_d + flux.d_wb))
+            / self.l_q_h;
+        (did, diq)
+    }
+
+    /// Cogging torque at mechanical angle `theta_m` (eq. 16). [N·m]
+    #[inline]
+    pub fn cogging_torque_nm(&self, theta_m: f64) -> f64 {
+        self.cogging
+            .iter()
+            .take(self.n_cogging)
+            .map(|&(a, n, ph)| a * libm::sin(n * theta_m + ph))
+            .sum()
+    }
+
+    /// Slotting energy W(θ_m) whose negative slope is the cogging torque. [J]
+    pub fn cogging_energy_j(&self, theta_m: f64) -> f64 {
+        self.cogging
+            .iter()
+            .take(self.n_cogging)
+            .map(|&(a, n, ph)| a / n * libm::cos(n * theta_m + ph))
+            .sum()
+    }
+
+    /// Energy stored in the winding inductances, ¾(L_d·i_d² + L_q·i_q²). [J]
+    pub fn winding_energy_j(&self, i_d: f64, i_q: f64) -> f64 {
+        0.75 * (self.l_d_h * i_d * i_d + self.l_q_h * i_q * i_q)
+    }
+
+    /// Peak line-to-line back-EMF at electrical speed `omega_e`. [V]
+    pub fn line_emf_peak_v(&self, omega_e: f64) -> f64 {
+        libm::sqrt(3.0) * self.psi_f_wb * libm::fabs(omega_e)
+    }
+}
