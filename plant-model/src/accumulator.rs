@@ -36,6 +36,20 @@ impl GasCharge {
         (self.precharge_pa + ATMOSPHERE_PA) * libm::pow(ratio, self.exponent) - ATMOSPHERE_PA
     }
 
+    /// Rate of change of the absolute gas pressure `p_abs` while oil flows in at `q` with
+    /// `oil_m3` inside: the polytropic law in rate form, dp/dt = n·p·q/V_g, which the plant
+    /// integrates instead of evaluating p_0·(V_0/V_g)^n (a `pow`) at every stage. [Pa/s]
+    #[inline]
+    pub fn pressure_rate(&self, p_abs: f64, oil_m3: f64, q: f64) -> f64 {
+        let gas = (self.shell_volume_m3 - oil_m3).max(1e-3 * self.shell_volume_m3);
+        self.exponent * p_abs * q / gas
+    }
+
+    /// Absolute gas pressure at precharge. [Pa]
+    pub fn precharge_abs_pa(&self) -> f64 {
+        self.precharge_pa + ATMOSPHERE_PA
+    }
+
     /// Oil volume in equilibrium with gauge pressure `p` (0 at or below precharge). [m³]
     pub fn oil_volume_m3(&self, p: f64) -> f64 {
         if p <= self.precharge_pa {
@@ -98,11 +112,11 @@ impl Absorber {
         }
     }
 
-    /// dq/dt of the inlet flow `q` (into the absorber) with `oil_m3` inside, port at `p_a`;
-    /// zero while the poppet is closed (empty absorber and port pressure below the gas). [m³/s²]
+    /// dq/dt of the inlet flow `q` (into the absorber) with `oil_m3` inside at gas pressure
+    /// `p_gas` (gauge), port at `p_a`; zero while the poppet is closed (empty absorber and
+    /// port pressure below the gas). [m³/s²]
     #[inline]
-    pub fn flow_derivative(&self, p_a: f64, oil_m3: f64, q: f64) -> f64 {
-        let p_gas = self.gas.pressure_pa(oil_m3);
+    pub fn flow_derivative(&self, p_a: f64, p_gas: f64, oil_m3: f64, q: f64) -> f64 {
         let drive = p_a - p_gas - self.resistance_pa_s_m3 * q;
         if oil_m3 <= 0.0 && q <= 0.0 && drive < 0.0 {
             0.0

@@ -26,13 +26,56 @@
 
 use crate::rig::{MotorParams, MAX_COGGING_HARMONICS, MAX_FLUX_HARMONICS};
 
+/// A unit phasor cos θ + j·sin θ; harmonics k·θ come from integer powers, so one `sincos`
+/// of the shaft angle serves every harmonic of an evaluation without range reduction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phasor {
+    /// cos θ.
+    pub cos: f64,
+    /// sin θ.
+    pub sin: f64,
+}
+
+impl Phasor {
+    /// The phasor of angle `theta` (one libm call). [rad]
+    #[inline]
+    pub fn of(theta: f64) -> Phasor {
+        let (sin, cos) = libm::sincos(theta);
+        Phasor { cos, sin }
+    }
+
+    /// Product (angle sum).
+    #[inline]
+    pub fn mul(self, o: Phasor) -> Phasor {
+        Phasor {
+            cos: self.cos * o.cos - self.sin * o.sin,
+            sin: self.sin * o.cos + self.cos * o.sin,
+        }
+    }
+
+    /// The k-th power (angle k·θ) by binary exponentiation; rounding grows like k·ε.
+    #[inline]
+    pub fn pow(self, mut k: u32) -> Phasor {
+        let mut base = self;
+        let mut acc = Phasor { cos: 1.0, sin: 0.0 };
+        while k > 0 {
+            if k & 1 == 1 {
+                acc = acc.mul(base);
+            }
+            base = base.mul(base);
+            k >>= 1;
+        }
+        acc
+    }
+}
+
 /// One flux harmonic as it appears in d-q: ψ_df += a·cos(m·θ_e + φ), ψ_qf += s·a·sin(m·θ_e + φ).
 #[derive(Clone, Copy, Debug)]
 struct DqFluxTerm {
     amplitude_wb: f64,
-    multiple: f64,
+    multiple: u32,
     sequence: f64,
-    phase_rad: f64,
+    phase: Phasor,
 }
 
 /// The magnet flux in d-q at one rotor angle, with its angular derivatives.
@@ -63,7 +106,7 @@ pub struct Motor {
     pub psi_f_wb: f64,
     flux_terms: [DqFluxTerm; MAX_FLUX_HARMONICS],
     n_flux_terms: usize,
-    cogging: [(f64, f64, f64); MAX_COGGING_HARMONICS],
+    cogging: [(f64, u32, Phasor); MAX_COGGING_HARMONICS],
     n_cogging: usize,
 }
 
@@ -72,9 +115,9 @@ impl Motor {
     pub fn new(p: &MotorParams) -> Motor {
         let empty = DqFluxTerm {
             amplitude_wb: 0.0,
-            multiple: 0.0,
+            multiple: 0,
             sequence: 0.0,
-            phase_rad: 0.0,
+            phase: Phasor { cos: 1.0, sin: 0.0 },
         };
         let mut flux_terms = [empty; MAX_FLUX_HARMONICS];
         let mut n_flux_terms = 0;
@@ -87,16 +130,16 @@ impl Motor {
             };
             flux_terms[n_flux_terms] = DqFluxTerm {
                 amplitude_wb: h.amplitude_wb,
-                multiple: multiple as f64,
+                multiple,
                 sequence,
-                phase_rad: h.phase_rad,
+                phase: Phasor::of(h.phase_rad),
             };
             n_flux_terms += 1;
         }
-        let mut cogging = [(0.0, 0.0, 0.0); MAX_COGGING_HARMONICS];
+        let mut cogging = [(0.0, 0, Phasor { cos: 1.0, sin: 0.0 }); MAX_COGGING_HARMONICS];
         let mut n_cogging = 0;
         for c in p.cogging.iter().filter(|c| c.amplitude_nm > 0.0) {
-            cogging[n_cogging] = (c.amplitude_nm, c.order as f64, c.phase_rad);
+            cogging[n_cogging] = (c.amplitude_nm, c.order, Phasor::of(c.phase_rad));
             n_cogging += 1;
         }
         Motor {
@@ -113,8 +156,13 @@ impl Motor {
     }
 
     /// Magnet flux in d-q at electrical angle `theta_e` (eq. 18).
-    #[inline]
     pub fn magnet_flux(&self, theta_e: f64) -> MagnetFlux {
+        self.magnet_flux_at(Phasor::of(theta_e))
+    }
+
+    /// Magnet flux in d-q at the electrical-angle phasor `e` (eq. 18).
+    #[inline]
+    pub fn magnet_flux_at(&self, e: Phasor) -> MagnetFlux {
         let mut f = MagnetFlux {
             d_wb: self.psi_f_wb,
             q_wb: 0.0,
@@ -122,12 +170,12 @@ impl Motor {
             q_slope_wb: 0.0,
         };
         for t in self.flux_terms.iter().take(self.n_flux_terms) {
-            let arg = t.multiple * theta_e + t.phase_rad;
-            let (s, c) = (libm::sin(arg), libm::cos(arg));
-            f.d_wb += t.amplitude_wb * c;
-            f.q_wb += t.sequence * t.amplitude_wb * s;
-            f.d_slope_wb -= t.multiple * t.amplitude_wb * s;
-            f.q_slope_wb += t.sequence * t.multiple * t.amplitude_wb * c;
+            let h = e.pow(t.multiple).mul(t.phase);
+            let m = t.multiple as f64;
+            f.d_wb += t.amplitude_wb * h.cos;
+            f.q_wb += t.sequence * t.amplitude_wb * h.sin;
+            f.d_slope_wb -= m * t.amplitude_wb * h.sin;
+            f.q_slope_wb += t.sequence * m * t.amplitude_wb * h.cos;
         }
         f
     }
@@ -165,21 +213,27 @@ impl Motor {
     }
 
     /// Cogging torque at mechanical angle `theta_m` (eq. 16). [N·m]
-    #[inline]
     pub fn cogging_torque_nm(&self, theta_m: f64) -> f64 {
+        self.cogging_torque_at(Phasor::of(theta_m))
+    }
+
+    /// Cogging torque at the mechanical-angle phasor `m` (eq. 16). [N·m]
+    #[inline]
+    pub fn cogging_torque_at(&self, m: Phasor) -> f64 {
         self.cogging
             .iter()
             .take(self.n_cogging)
-            .map(|&(a, n, ph)| a * libm::sin(n * theta_m + ph))
+            .map(|&(a, n, ph)| a * m.pow(n).mul(ph).sin)
             .sum()
     }
 
     /// Slotting energy W(θ_m) whose negative slope is the cogging torque. [J]
     pub fn cogging_energy_j(&self, theta_m: f64) -> f64 {
+        let m = Phasor::of(theta_m);
         self.cogging
             .iter()
             .take(self.n_cogging)
-            .map(|&(a, n, ph)| a / n * libm::cos(n * theta_m + ph))
+            .map(|&(a, n, ph)| a / n as f64 * m.pow(n).mul(ph).cos)
             .sum()
     }
 

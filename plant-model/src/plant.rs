@@ -33,11 +33,12 @@
 //! `input − Δstored − losses − external work − projection losses` must vanish up to the
 //! constant-β approximation of oil compression energy (order p/2β of the boundary work).
 
+use crate::accumulator::ATMOSPHERE_PA;
 use crate::accumulator::{Absorber, GasCharge};
 use crate::cylinder::Cylinder;
 use crate::friction::{Friction, Slip};
 use crate::inverter::{dq_to_abc, pole_to_dq, Inverter};
-use crate::motor::Motor;
+use crate::motor::{Motor, Phasor};
 use crate::pump::Pump;
 use crate::rig::{Rig, RigError};
 use crate::sensors::{SensorReadings, Sensors};
@@ -62,7 +63,11 @@ mod ix {
     pub const E_MECH: usize = 14;
     pub const E_HYD: usize = 15;
     pub const E_EXT: usize = 16;
-    pub const N: usize = 17;
+    /// Absolute gas pressure of the absorber.
+    pub const ABS_PGAS: usize = 17;
+    /// Absolute gas pressure of the fill accumulator.
+    pub const FILL_PGAS: usize = 18;
+    pub const N: usize = 19;
 }
 
 type Vector = [f64; ix::N];
@@ -265,6 +270,7 @@ struct Aux {
 #[derive(Clone, Debug)]
 pub struct Plant {
     motor: Motor,
+    pole_pairs: u32,
     inverter: Inverter,
     inertia: f64,
     shaft_viscous: f64,
@@ -326,6 +332,8 @@ impl Plant {
             0.0
         };
         x[ix::FILL_OIL] = fill_gas.oil_volume_m3(rig.fill.pressure_pa);
+        x[ix::FILL_PGAS] = rig.fill.pressure_pa + ATMOSPHERE_PA;
+        x[ix::ABS_PGAS] = absorber.gas.pressure_pa(x[ix::ABS_OIL]) + ATMOSPHERE_PA;
         x[ix::P_SENSOR] = init.p_a_pa;
         let slip0 = |v: f64| {
             if v == 0.0 {
@@ -338,6 +346,7 @@ impl Plant {
         };
         let mut plant = Plant {
             motor: Motor::new(&rig.motor),
+            pole_pairs: rig.motor.pole_pairs,
             inverter: Inverter::new(&rig.inverter),
             inertia: rig.shaft.inertia_kg_m2(),
             shaft_viscous: rig.shaft.viscous_nm_s,
@@ -473,29 +482,36 @@ impl Plant {
         self.project(inputs);
     }
 
-    /// Event functions: positive while nothing switches, crossing zero at an event.
+    /// Event functions: positive while nothing switches, crossing zero at an event. The
+    /// drive torque and force are evaluated only when a body is stuck (a sliding body's event
+    /// is its velocity), so a step costs four evaluations when nothing switches.
     fn event_functions(&self, x: &Vector, inputs: &Inputs) -> [f64; EVENTS] {
         let mut g = [1.0; EVENTS];
-        let needs_drive = self.shaft_friction.is_active() || self.piston_friction.is_active();
-        let aux = if needs_drive {
+        let shaft =
+            self.shaft_friction.is_active() && !matches!(inputs.drive, Drive::ShaftSpeed { .. });
+        let piston =
+            self.piston_friction.is_active() && inputs.piston.is_none() && !self.cylinder.blocked;
+        let stuck = (shaft && self.discrete.shaft == Slip::Stuck)
+            || (piston && self.discrete.piston == Slip::Stuck);
+        let aux = if stuck {
             self.derivative(x, inputs).1
         } else {
             Aux::default()
         };
-        let friction_event = |f: &Friction, slip: Slip, velocity: f64, drive: f64| match slip {
+        let event = |f: &Friction, slip: Slip, velocity: f64, drive: f64| match slip {
             Slip::Sliding(dir) => velocity * dir,
             Slip::Stuck => f.breakaway - libm::fabs(drive),
         };
-        if self.shaft_friction.is_active() && !matches!(inputs.drive, Drive::ShaftSpeed { .. }) {
-            g[0] = friction_event(
+        if shaft {
+            g[0] = event(
                 &self.shaft_friction,
                 self.discrete.shaft,
                 x[ix::OMEGA],
                 aux.shaft_drive,
             );
         }
-        if self.piston_friction.is_active() && inputs.piston.is_none() && !self.cylinder.blocked {
-            g[1] = friction_event(
+        if piston {
+            g[1] = event(
                 &self.piston_friction,
                 self.discrete.piston,
                 x[ix::V],
@@ -511,8 +527,8 @@ impl Plant {
 
     /// Reads every sensor at the present instant (the ADC trigger at the PWM centre).
     pub fn sample(&mut self) -> SensorReadings {
-        let (s, c) = sincos(self.motor.pole_pairs * self.x[ix::THETA]);
-        let i_abc = dq_to_abc(self.x[ix::ID], self.x[ix::IQ], s, c);
+        let e = Phasor::of(self.x[ix::THETA]).pow(self.pole_pairs);
+        let i_abc = dq_to_abc(self.x[ix::ID], self.x[ix::IQ], e.sin, e.cos);
         let p_sensed = if self.sensor_lag_s > 0.0 {
             self.x[ix::P_SENSOR]
         } else {
@@ -629,7 +645,23 @@ impl Plant {
     /// Enforces the non-smooth constraints at a step boundary and books the energy they
     /// remove.
     fn project(&mut self, inputs: &Inputs) {
-        let (_, aux) = self.derivative(&self.x, inputs);
+        // The drive torque and force matter only to a stuck body or one whose velocity
+        // reached zero; evaluate the model only then.
+        let shaft_switch = match self.discrete.shaft {
+            Slip::Stuck => true,
+            Slip::Sliding(dir) => self.x[ix::OMEGA] * dir <= 0.0,
+        };
+        let piston_switch = match self.discrete.piston {
+            Slip::Stuck => true,
+            Slip::Sliding(dir) => self.x[ix::V] * dir <= 0.0,
+        };
+        let needs = (shaft_switch && self.shaft_friction.is_active())
+            || (piston_switch && self.piston_friction.is_active());
+        let aux = if needs {
+            self.derivative(&self.x, inputs).1
+        } else {
+            Aux::default()
+        };
         // Shaft stick/slip (not when the speed is prescribed).
         if !matches!(inputs.drive, Drive::ShaftSpeed { .. }) && self.shaft_friction.is_active() {
             let w = self.x[ix::OMEGA];
@@ -658,6 +690,7 @@ impl Plant {
                 self.projection_loss_j += 0.5 * self.absorber.inertance_kg_m4 * q * q;
                 self.x[ix::ABS_Q] = 0.0;
             }
+            self.x[ix::ABS_PGAS] = self.absorber.gas.precharge_abs_pa();
             // Oil overdrawn within the step returns from the port node.
             let overdraw = -self.x[ix::ABS_OIL];
             if overdraw > 0.0 {
@@ -731,12 +764,14 @@ impl Plant {
         let omega = x[ix::OMEGA];
         let (i_d, i_q) = (x[ix::ID], x[ix::IQ]);
         let p_n = self.motor.pole_pairs;
-        let theta_e = p_n * theta;
         let omega_e = p_n * omega;
+        // One sincos per evaluation: every harmonic is a power of the shaft-angle phasor.
+        let rot_m = Phasor::of(theta);
+        let rot_e = rot_m.pow(self.pole_pairs);
 
         // --- motor and inverter (eq. 1–3, 17–19)
-        let flux = self.motor.magnet_flux(theta_e);
-        let (s_e, c_e) = sincos(theta_e);
+        let flux = self.motor.magnet_flux_at(rot_e);
+        let (s_e, c_e) = (rot_e.sin, rot_e.cos);
         aux.i_abc = dq_to_abc(i_d, i_q, s_e, c_e);
         let mut p_in = 0.0;
         match inputs.drive {
@@ -765,12 +800,12 @@ impl Plant {
             Drive::Currents { .. } | Drive::ShaftSpeed { .. } => {}
         }
         aux.t_em = self.motor.torque_nm(i_d, i_q, &flux);
-        aux.t_cog = self.motor.cogging_torque_nm(theta);
+        aux.t_cog = self.motor.cogging_torque_at(rot_m);
         dx[ix::E_CU] = 1.5 * self.motor.r_s_ohm * (i_d * i_d + i_q * i_q);
 
         // --- pump (eq. 9, 20) and shaft (eq. 4)
         let (p_a, p_b) = (x[ix::PA], x[ix::PB]);
-        let factor = self.pump.displacement_factor(theta);
+        let factor = self.pump.displacement_factor_at(theta, rot_m);
         aux.t_pump = self.pump.load_torque(p_a, p_b, factor);
         aux.shaft_drive = aux.t_em + aux.t_cog - aux.t_pump - self.shaft_viscous * omega;
         let t_fric = self.shaft_friction.force(self.discrete.shaft);
@@ -795,7 +830,7 @@ impl Plant {
         let mut p_mech = self.shaft_viscous * omega * omega + t_fric * omega;
 
         // --- hydraulics (eq. 9–12, 22–26)
-        let p_fill = self.fill_gas.pressure_pa(x[ix::FILL_OIL]);
+        let p_fill = x[ix::FILL_PGAS] - ATMOSPHERE_PA;
         aux.p_fill = p_fill;
         aux.q_geo = self.pump.geometric_flow(omega, factor);
         let q_int = self.pump.internal_leakage * (p_a - p_b);
@@ -815,6 +850,9 @@ impl Plant {
         dx[ix::PA] = self.beta / v1 * net_a;
         dx[ix::PB] = self.beta / v2 * net_b;
         dx[ix::FILL_OIL] = q_ext_a + q_ext_b + q_rel_a + q_rel_b - q_chk_a - q_chk_b;
+        dx[ix::FILL_PGAS] =
+            self.fill_gas
+                .pressure_rate(x[ix::FILL_PGAS], x[ix::FILL_OIL], dx[ix::FILL_OIL]);
         let mut p_hyd = (q_int + q_cyl) * (p_a - p_b)
             + q_ext_a * (p_a - p_fill)
             + q_ext_b * (p_b - p_fill)
@@ -824,7 +862,12 @@ impl Plant {
             + q_rel_b * (p_b - p_fill);
         if self.absorber.enabled {
             dx[ix::ABS_OIL] = q_abs;
-            dx[ix::ABS_Q] = self.absorber.flow_derivative(p_a, abs_oil, q_abs);
+            let p_gas = x[ix::ABS_PGAS] - ATMOSPHERE_PA;
+            dx[ix::ABS_Q] = self.absorber.flow_derivative(p_a, p_gas, abs_oil, q_abs);
+            dx[ix::ABS_PGAS] = self
+                .absorber
+                .gas
+                .pressure_rate(x[ix::ABS_PGAS], abs_oil, q_abs);
             p_hyd += self.absorber.resistance_pa_s_m3 * q_abs * q_abs;
         }
 
@@ -865,11 +908,6 @@ impl Plant {
         dx[ix::E_IN] = p_in;
         (dx, aux)
     }
-}
-
-#[inline]
-fn sincos(a: f64) -> (f64, f64) {
-    (libm::sin(a), libm::cos(a))
 }
 
 #[inline]

@@ -18,6 +18,7 @@
 //! each port to the case, which drains to the fill accumulator (eq. 9 with p_r the case
 //! pressure).
 
+use crate::motor::Phasor;
 use crate::rig::PumpParams;
 use core::f64::consts::PI;
 
@@ -32,6 +33,10 @@ pub struct Pump {
     pitch: f64,
     /// sin(m·pitch/2)/sin(pitch/2)·π/z for m = ⌈z/2⌉ − 1 … ⌈z/2⌉ + 1 pistons delivering.
     series_gain: [f64; 3],
+    /// Phasors of (m − 1)·pitch/2 for the same three m.
+    series_phase: [Phasor; 3],
+    /// Phasors of −j·pitch, j = 0 … MAX_PISTONS − 1, to reduce the shaft angle to [0, pitch).
+    back_by_pitch: [Phasor; MAX_PISTONS],
     m_base: u32,
     /// Scale of the ripple about the mean (0: ideal flow, 1: kinematic). [1]
     ripple_scale: f64,
@@ -42,6 +47,9 @@ pub struct Pump {
     /// Extra port-A-to-case leakage. [(m³/s)/Pa]
     pub extra_leakage: f64,
 }
+
+/// Largest piston count the model takes (validation allows up to this).
+pub const MAX_PISTONS: usize = 31;
 
 /// Peak-to-peak kinematic flow ripple over mean flow for `z` pistons (the closed form
 /// quoted in the module docs).
@@ -70,9 +78,15 @@ impl Pump {
         let pitch = 2.0 * PI / z;
         let m_base = p.pistons.div_ceil(2).saturating_sub(1);
         let mut series_gain = [0.0; 3];
-        for (k, g) in series_gain.iter_mut().enumerate() {
+        let mut series_phase = [Phasor::of(0.0); 3];
+        for (k, (g, ph)) in series_gain.iter_mut().zip(&mut series_phase).enumerate() {
             let m = (m_base + k as u32) as f64;
             *g = PI / z * libm::sin(m * pitch / 2.0) / libm::sin(pitch / 2.0);
+            *ph = Phasor::of((m - 1.0) * pitch / 2.0);
+        }
+        let mut back_by_pitch = [Phasor::of(0.0); MAX_PISTONS];
+        for (j, b) in back_by_pitch.iter_mut().enumerate() {
+            *b = Phasor::of(-(j as f64) * pitch);
         }
         let ripple_scale = if !p.piston_ripple {
             0.0
@@ -86,6 +100,8 @@ impl Pump {
             pistons: p.pistons,
             pitch,
             series_gain,
+            series_phase,
+            back_by_pitch,
             m_base,
             ripple_scale,
             internal_leakage: p.internal_leakage_m3_s_pa,
@@ -95,23 +111,42 @@ impl Pump {
     }
 
     /// The kinematic shape s(θ) of eq. 20 (mean 1 over a revolution). [1]
-    #[inline]
     pub fn kinematic_shape(&self, theta: f64) -> f64 {
-        // Smallest piston angle in [0, pitch); pistons at φ0 + j·pitch deliver while < π.
-        let phi0 = rem_euclid(theta, self.pitch);
+        self.kinematic_shape_at(theta, Phasor::of(theta))
+    }
+
+    /// The kinematic shape at shaft angle `theta` whose phasor is `rot` (no trigonometric
+    /// call: the angle is reduced by a whole number of pitches through a phasor table). [1]
+    #[inline]
+    pub fn kinematic_shape_at(&self, theta: f64, rot: Phasor) -> f64 {
+        // Smallest piston angle φ0 in [0, pitch); pistons at φ0 + j·pitch deliver while < π.
+        let turns = libm::floor(theta / self.pitch);
+        let phi0 = (theta - turns * self.pitch).clamp(0.0, self.pitch);
+        let j = rem_euclid(turns, self.pistons as f64) as usize;
         let m = libm::ceil((PI - phi0) / self.pitch) as u32;
-        let k = m.saturating_sub(self.m_base).min(2) as usize;
-        let gain = self.series_gain.get(k).copied().unwrap_or(0.0);
-        gain * libm::sin(phi0 + (m as f64 - 1.0) * self.pitch / 2.0)
+        let k = (m.saturating_sub(self.m_base).min(2)) as usize;
+        let (Some(gain), Some(phase), Some(back)) = (
+            self.series_gain.get(k),
+            self.series_phase.get(k),
+            self.back_by_pitch.get(j),
+        ) else {
+            return 1.0;
+        };
+        gain * rot.mul(*back).mul(*phase).sin
     }
 
     /// Instantaneous displacement factor 1 + scale·(s(θ) − 1) applied to flow and torque. [1]
-    #[inline]
     pub fn displacement_factor(&self, theta: f64) -> f64 {
+        self.displacement_factor_at(theta, Phasor::of(theta))
+    }
+
+    /// [`Pump::displacement_factor`] with the shaft-angle phasor supplied. [1]
+    #[inline]
+    pub fn displacement_factor_at(&self, theta: f64, rot: Phasor) -> f64 {
         if self.ripple_scale == 0.0 {
             1.0
         } else {
-            1.0 + self.ripple_scale * (self.kinematic_shape(theta) - 1.0)
+            1.0 + self.ripple_scale * (self.kinematic_shape_at(theta, rot) - 1.0)
         }
     }
 

@@ -499,8 +499,8 @@ impl Rig {
         non_negative("shaft.static_nm", s.static_nm)?;
         let p = &self.pump;
         positive("pump.displacement_m3_per_rev", p.displacement_m3_per_rev)?;
-        if p.pistons < 3 {
-            return Err(RigError::new("pump.pistons", "must be at least 3"));
+        if p.pistons < 3 || p.pistons as usize > crate::pump::MAX_PISTONS {
+            return Err(RigError::new("pump.pistons", "must be 3 to 31"));
         }
         non_negative("pump.ripple_amplitude_ratio", p.ripple_amplitude_ratio)?;
         if p.ripple_amplitude_ratio >= 1.0 {
