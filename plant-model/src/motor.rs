@@ -36,21 +36,24 @@ pub struct Phasor {
     pub sin: f64,
 }
 
+impl core::ops::Mul for Phasor {
+    type Output = Phasor;
+    /// Product (angle sum).
+    #[inline]
+    fn mul(self, o: Phasor) -> Phasor {
+        Phasor {
+            cos: self.cos * o.cos - self.sin * o.sin,
+            sin: self.sin * o.cos + self.cos * o.sin,
+        }
+    }
+}
+
 impl Phasor {
     /// The phasor of angle `theta` (one libm call). [rad]
     #[inline]
     pub fn of(theta: f64) -> Phasor {
         let (sin, cos) = libm::sincos(theta);
         Phasor { cos, sin }
-    }
-
-    /// Product (angle sum).
-    #[inline]
-    pub fn mul(self, o: Phasor) -> Phasor {
-        Phasor {
-            cos: self.cos * o.cos - self.sin * o.sin,
-            sin: self.sin * o.cos + self.cos * o.sin,
-        }
     }
 
     /// The k-th power (angle k·θ) by binary exponentiation; rounding grows like k·ε.
@@ -60,9 +63,9 @@ impl Phasor {
         let mut acc = Phasor { cos: 1.0, sin: 0.0 };
         while k > 0 {
             if k & 1 == 1 {
-                acc = acc.mul(base);
+                acc = acc * base;
             }
-            base = base.mul(base);
+            base = base * base;
             k >>= 1;
         }
         acc
@@ -170,7 +173,7 @@ impl Motor {
             q_slope_wb: 0.0,
         };
         for t in self.flux_terms.iter().take(self.n_flux_terms) {
-            let h = e.pow(t.multiple).mul(t.phase);
+            let h = e.pow(t.multiple) * t.phase;
             let m = t.multiple as f64;
             f.d_wb += t.amplitude_wb * h.cos;
             f.q_wb += t.sequence * t.amplitude_wb * h.sin;
@@ -223,7 +226,7 @@ impl Motor {
         self.cogging
             .iter()
             .take(self.n_cogging)
-            .map(|&(a, n, ph)| a * m.pow(n).mul(ph).sin)
+            .map(|&(a, n, ph)| a * (m.pow(n) * ph).sin)
             .sum()
     }
 
@@ -233,7 +236,7 @@ impl Motor {
         self.cogging
             .iter()
             .take(self.n_cogging)
-            .map(|&(a, n, ph)| a / n as f64 * m.pow(n).mul(ph).cos)
+            .map(|&(a, n, ph)| a / n as f64 * (m.pow(n) * ph).cos)
             .sum()
     }
 

@@ -132,7 +132,7 @@ impl Pump {
         ) else {
             return 1.0;
         };
-        gain * rot.mul(*back).mul(*phase).sin
+        gain * (rot * *back * *phase).sin
     }
 
     /// Instantaneous displacement factor 1 + scale·(s(θ) − 1) applied to flow and torque. [1]
