@@ -2,8 +2,9 @@
 //! rig in the paper's low-speed pressure-holding state (blocked cylinder, 5 MPa, shaft at
 //! ≈ 60 rpm), with the catalogue's effects off and with every low-speed effect on.
 
-use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, criterion_main, Criterion};
 use plant_model::{Effect, InitialConditions, Inputs, Plant, Rig};
+use std::hint::black_box;
 
 fn holding_plant(effects: &[&str]) -> Plant {
     let mut rig = Rig::nominal();
