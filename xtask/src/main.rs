@@ -1,1 +1,165 @@
-fn main() {}
+//! `cargo xtask test` — every check the project has, in the order CI runs them:
+//!
+//! 1. the `thumbv7em-none-eabihf` target (installed with rustup when missing);
+//! 2. `cargo fmt --check` and `cargo clippy --workspace --all-targets -D warnings`;
+//! 3. the host tests of the whole workspace;
+//! 4. the firmware for the STM32G474RE with warnings denied, and its flash and static-RAM
+//!    use against the budget (64 KiB / 16 KiB, so it also fits an STM32G431), written to
+//!    `target/firmware-size.json`.
+//!
+//! `cargo xtask fw-size` does step 4 alone.
+
+use anyhow::{bail, Context, Result};
+use object::{Object, ObjectSection, SectionFlags};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const TARGET: &str = "thumbv7em-none-eabihf";
+const FLASH_BUDGET: u64 = 64 * 1024;
+const RAM_BUDGET: u64 = 16 * 1024;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("test") => test(),
+        Some("fw-size") => firmware().map(|_| ()),
+        _ => {
+            eprintln!("usage: cargo xtask <test | fw-size>");
+            std::process::exit(2);
+        }
+    };
+    if let Err(e) = result {
+        eprintln!("xtask: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives one level below the workspace root")
+        .to_path_buf()
+}
+
+fn cargo() -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(root());
+    c
+}
+
+fn run(step: &str, cmd: &mut Command) -> Result<()> {
+    eprintln!("\n=== {step}: {cmd:?}");
+    let status = cmd
+        .status()
+        .with_context(|| format!("{step}: could not start {cmd:?}"))?;
+    if !status.success() {
+        bail!("{step} failed ({status})");
+    }
+    Ok(())
+}
+
+fn ensure_target() -> Result<()> {
+    let out = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .context(
+            "rustup is needed to install the thumbv7em-none-eabihf target (https://rustup.rs)",
+        )?;
+    if !String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .any(|l| l.trim() == TARGET)
+    {
+        run(
+            "install the Cortex-M4F target",
+            Command::new("rustup").args(["target", "add", TARGET]),
+        )?;
+    }
+    Ok(())
+}
+
+fn test() -> Result<()> {
+    ensure_target()?;
+    run("format", cargo().args(["fmt", "--all", "--", "--check"]))?;
+    run(
+        "lint",
+        cargo().args([
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ]),
+    )?;
+    run("host tests", cargo().args(["test", "--workspace"]))?;
+    firmware()?;
+    eprintln!("\nxtask: all checks passed");
+    Ok(())
+}
+
+/// Builds the firmware image with warnings denied and checks its size.
+fn firmware() -> Result<(u64, u64)> {
+    ensure_target()?;
+    run(
+        "firmware (warnings denied)",
+        cargo().args([
+            "build",
+            "--release",
+            "--package",
+            "firmware",
+            "--bin",
+            "firmware",
+            "--target",
+            TARGET,
+            "--config",
+            &format!("target.{TARGET}.rustflags=[\"-D\", \"warnings\"]"),
+        ]),
+    )?;
+    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"));
+    let elf = target_dir.join(TARGET).join("release").join("firmware");
+    let (flash, ram) = image_size(&elf)?;
+    let json = format!(
+        "{{\"flash_bytes\": {flash}, \"static_ram_bytes\": {ram}, \"flash_budget_bytes\": {FLASH_BUDGET}, \"ram_budget_bytes\": {RAM_BUDGET}}}\n"
+    );
+    std::fs::create_dir_all(&target_dir)?;
+    std::fs::write(target_dir.join("firmware-size.json"), json)?;
+    eprintln!(
+        "firmware: flash {flash} B ({:.1} KiB of {} KiB), static RAM {ram} B ({:.1} KiB of {} KiB)",
+        flash as f64 / 1024.0,
+        FLASH_BUDGET / 1024,
+        ram as f64 / 1024.0,
+        RAM_BUDGET / 1024
+    );
+    if flash > FLASH_BUDGET || ram > RAM_BUDGET {
+        bail!("the firmware exceeds its flash/RAM budget (see above)");
+    }
+    Ok((flash, ram))
+}
+
+/// Flash = allocated sections with contents (code, read-only data, .data's load image);
+/// static RAM = writable allocated sections (.data, .bss, .uninit). Stack is not static.
+fn image_size(elf: &Path) -> Result<(u64, u64)> {
+    let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+    let file = object::File::parse(&*data).with_context(|| format!("parsing {}", elf.display()))?;
+    let (mut flash, mut ram) = (0, 0);
+    for s in file.sections() {
+        let SectionFlags::Elf { sh_flags } = s.flags() else {
+            continue;
+        };
+        const ALLOC: u64 = 0x2;
+        const WRITE: u64 = 0x1;
+        if sh_flags & ALLOC == 0 {
+            continue;
+        }
+        let has_contents = s.kind() != object::SectionKind::UninitializedData;
+        if sh_flags & WRITE != 0 {
+            ram += s.size();
+        }
+        if has_contents {
+            flash += s.size();
+        }
+    }
+    Ok((flash, ram))
+}
