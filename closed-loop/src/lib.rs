@@ -1,0 +1,186 @@
+//! The closed loop: the firmware's control core against the plant model, across the one
+//! seam of the design.
+//!
+//! Each PWM period: the plant's sensors are sampled at the PWM centre (ADC counts, encoder
+//! count — exactly what the MCU's peripherals give), the control core's ISR body turns them
+//! into three duties and the bridge enable, and the plant integrates one period with those
+//! duties held (zero-order hold). Nothing of the plant's state reaches the controller except
+//! through [`plant_model::SensorReadings`] → [`firmware::io::Measurements`].
+//!
+//! `no_std`: the same harness runs in `eha`, in the cross-crate tests, and in the PIL binary
+//! on a Cortex-M4F.
+#![no_std]
+#![deny(missing_docs)]
+
+pub mod config;
+pub mod scenario;
+
+pub use config::controller_config;
+pub use scenario::{by_name, Scenario, ScenarioKind, SCENARIOS};
+
+use firmware::io::{Measurements, Outputs};
+use firmware::{Command, Controller};
+use plant_model::{InitialConditions, Inputs, Observables, Plant, Rig, RigError};
+
+/// One PWM period of a run: what the controller reported and what the plant really did.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample {
+    /// The controller's telemetry (its measured and commanded quantities).
+    pub telemetry: firmware::TelemetryFrame,
+    /// The plant's true state at the same instant.
+    pub truth: Observables,
+    /// The controller's outputs for the next period.
+    pub outputs: Outputs,
+}
+
+/// The control core in closed loop with the plant.
+pub struct ClosedLoop {
+    plant: Plant,
+    controller: Controller,
+    period_s: f64,
+    scenario: Scenario,
+    next_event: usize,
+    heartbeat_every: u32,
+    steps: u64,
+    last_outputs: Outputs,
+}
+
+/// Why a closed loop could not be built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BuildError {
+    /// The rig failed validation.
+    Rig(RigError),
+    /// The controller configuration derived from the rig failed validation.
+    Config(firmware::config::ConfigError),
+}
+
+impl core::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            BuildError::Rig(e) => write!(f, "{e}"),
+            BuildError::Config(e) => write!(f, "controller configuration: {e:?}"),
+        }
+    }
+}
+
+impl ClosedLoop {
+    /// The loop for `scenario` on the plant `rig` (effects already applied), controlled by
+    /// `config` (normally [`controller_config`] of the rig the engineer believes in), with
+    /// sensor noise seeded by `seed`.
+    pub fn new(
+        rig: &Rig,
+        config: &firmware::config::Config,
+        scenario: &Scenario,
+        seed: u64,
+    ) -> Result<ClosedLoop, BuildError> {
+        config.validate().map_err(BuildError::Config)?;
+        let mut rig = rig.clone();
+        rig.cylinder.blocked = scenario.blocked;
+        let init = InitialConditions {
+            p_a_pa: scenario.initial_pressure_pa,
+            ..InitialConditions::at_rest(&rig)
+        };
+        let plant = Plant::new(&rig, &init, seed).map_err(BuildError::Rig)?;
+        let period_s = 1.0 / config.rates.pwm_hz as f64;
+        // A heartbeat well inside the command timeout, as the bench PC sends over CAN.
+        let heartbeat_every =
+            ((0.25 * config.limits.command_timeout_s as f64 / period_s) as u32).max(1);
+        Ok(ClosedLoop {
+            plant,
+            controller: Controller::new(config),
+            period_s,
+            scenario: *scenario,
+            next_event: 0,
+            heartbeat_every,
+            steps: 0,
+            last_outputs: Outputs::DISABLED,
+        })
+    }
+
+    /// Time since the start. [s]
+    pub fn time_s(&self) -> f64 {
+        self.steps as f64 * self.period_s
+    }
+
+    /// The PWM period. [s]
+    pub fn period_s(&self) -> f64 {
+        self.period_s
+    }
+
+    /// The plant (for its energy books and true state).
+    pub fn plant(&self) -> &Plant {
+        &self.plant
+    }
+
+    /// The controller (for commands outside the scenario, fault injection, telemetry).
+    pub fn controller_mut(&mut self) -> &mut Controller {
+        &mut self.controller
+    }
+
+    /// Sends a command as the bench PC would; refused commands are returned.
+    pub fn command(&mut self, c: Command) -> Result<(), firmware::CommandError> {
+        self.controller.command(c)
+    }
+
+    /// One PWM period: scenario commands due now, sample, control, integrate.
+    pub fn step(&mut self) -> Sample {
+        self.step_with(|m| m)
+    }
+
+    /// One PWM period with the measurements passed through `tamper` first (fault injection:
+    /// an open pressure wire, an encoder jump, an over-current reading).
+    pub fn step_with(&mut self, tamper: impl FnOnce(Measurements) -> Measurements) -> Sample {
+        let t = self.time_s();
+        while let Some(ev) = self.scenario.events.get(self.next_event) {
+            match ev {
+                Some((at, cmd)) if *at <= t => {
+                    // Scenario commands are within range by construction; a refusal shows in
+                    // the telemetry's status like on the bench.
+                    let _ = self.controller.command(*cmd);
+                    self.next_event += 1;
+                }
+                Some(_) => break,
+                None => {
+                    self.next_event += 1;
+                }
+            }
+        }
+        if self.steps % self.heartbeat_every as u64 == 0 {
+            let _ = self.controller.command(Command::Heartbeat);
+        }
+        let r = self.plant.sample();
+        let m = tamper(Measurements {
+            adc_phase_current: r.adc_phase_current,
+            adc_dc_link: r.adc_dc_link,
+            adc_pressure: r.adc_pressure,
+            encoder_count: r.encoder_count,
+            encoder_index: r.encoder_index,
+        });
+        let truth = self.plant.observe();
+        let out = self.controller.on_current_sample(&m);
+        let telemetry = self.controller.telemetry();
+        let d = out.duties;
+        self.plant.advance(
+            self.period_s,
+            &Inputs::duties([d[0] as f64, d[1] as f64, d[2] as f64], out.pwm_enabled),
+        );
+        self.last_outputs = out;
+        self.steps += 1;
+        Sample {
+            telemetry,
+            truth,
+            outputs: out,
+        }
+    }
+
+    /// Runs until `t_end` seconds, calling `each` every `every` periods.
+    pub fn run(&mut self, t_end_s: f64, every: u32, mut each: impl FnMut(&Sample)) {
+        let n = libm::ceil((t_end_s - self.time_s()) / self.period_s).max(0.0) as u64;
+        for k in 0..n {
+            let s = self.step();
+            if k % every.max(1) as u64 == 0 {
+                each(&s);
+            }
+        }
+    }
+}

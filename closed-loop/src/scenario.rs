@@ -1,0 +1,122 @@
+//! Named scenarios: the paper's low-speed pressure holding, pressure and speed steps, and a
+//! slow stroke of the payload — each a plant configuration, an initial state and the
+//! commands the bench PC sends at given times.
+
+use firmware::{Command, Mode};
+
+/// Most commands a scenario sends.
+pub const MAX_EVENTS: usize = 6;
+
+/// What a scenario exercises (used to choose analysis windows).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ScenarioKind {
+    /// Steady pressure holding.
+    PressureHold,
+    /// A pressure setpoint step.
+    PressureStep,
+    /// A speed setpoint step.
+    SpeedStep,
+    /// The payload moved slowly under speed control.
+    SlowStroke,
+}
+
+/// A named scenario.
+#[derive(Clone, Copy, Debug)]
+pub struct Scenario {
+    /// Name used on the command line.
+    pub name: &'static str,
+    /// One line for `eha simulate --list`.
+    pub description: &'static str,
+    /// What it exercises.
+    pub kind: ScenarioKind,
+    /// Cylinder held at mid-stroke (pressure holding).
+    pub blocked: bool,
+    /// Port-A pressure at the start. [Pa]
+    pub initial_pressure_pa: f64,
+    /// Default length of the run. [s]
+    pub duration_s: f64,
+    /// When the steady state is reached (analysis starts here). [s]
+    pub steady_from_s: f64,
+    /// Commands and when they are sent. [s]
+    pub events: [Option<(f64, Command)>; MAX_EVENTS],
+}
+
+/// The paper's holding pressure. [Pa]
+pub const HOLD_PRESSURE_PA: f64 = 5e6;
+
+/// Every scenario.
+pub const SCENARIOS: [Scenario; 4] = [
+    Scenario {
+        name: "pressure-hold",
+        description: "the paper's low-speed pressure holding: blocked cylinder at 5 MPa, the pump turning only to replace leakage (about 60 rpm)",
+        kind: ScenarioKind::PressureHold,
+        blocked: true,
+        initial_pressure_pa: HOLD_PRESSURE_PA,
+        duration_s: 3.0,
+        steady_from_s: 1.0,
+        events: [
+            Some((0.0, Command::SetPressure { pa: HOLD_PRESSURE_PA as f32 })),
+            Some((0.0, Command::SetMode(Mode::Pressure))),
+            None,
+            None,
+            None,
+            None,
+        ],
+    },
+    Scenario {
+        name: "pressure-step",
+        description: "pressure step 3 → 5 MPa at 0.5 s, blocked cylinder",
+        kind: ScenarioKind::PressureStep,
+        blocked: true,
+        initial_pressure_pa: 3e6,
+        duration_s: 2.0,
+        steady_from_s: 0.5,
+        events: [
+            Some((0.0, Command::SetPressure { pa: 3e6 })),
+            Some((0.0, Command::SetMode(Mode::Pressure))),
+            Some((0.5, Command::SetPressure { pa: 5e6 })),
+            None,
+            None,
+            None,
+        ],
+    },
+    Scenario {
+        name: "speed-step",
+        description: "speed step 0 → 50 rad/s at 0.1 s, payload free",
+        kind: ScenarioKind::SpeedStep,
+        blocked: false,
+        initial_pressure_pa: 0.5e6,
+        duration_s: 1.0,
+        steady_from_s: 0.1,
+        events: [
+            Some((0.0, Command::SetSpeed { rad_s: 0.0 })),
+            Some((0.0, Command::SetMode(Mode::Speed))),
+            Some((0.1, Command::SetSpeed { rad_s: 50.0 })),
+            None,
+            None,
+            None,
+        ],
+    },
+    Scenario {
+        name: "slow-stroke",
+        description: "slow stroke of the 2000 kg payload: pump at 30 rad/s (≈1 mm/s) under speed control",
+        kind: ScenarioKind::SlowStroke,
+        blocked: false,
+        initial_pressure_pa: 0.5e6,
+        duration_s: 4.0,
+        steady_from_s: 1.0,
+        events: [
+            Some((0.0, Command::SetSpeed { rad_s: 0.0 })),
+            Some((0.0, Command::SetMode(Mode::Speed))),
+            Some((0.2, Command::SetSpeed { rad_s: 30.0 })),
+            None,
+            None,
+            None,
+        ],
+    },
+];
+
+/// The scenario called `name`.
+pub fn by_name(name: &str) -> Option<&'static Scenario> {
+    SCENARIOS.iter().find(|s| s.name == name)
+}
