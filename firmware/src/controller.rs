@@ -1,0 +1,545 @@
+//! The controller façade: one call per PWM period ([`Controller::on_current_sample`]) runs
+//! the current loop, the speed and pressure loops at their divided rates, the calibration
+//! sequence and the supervisor checks; [`Controller::command`] takes the commands.
+//!
+//! Order inside one call: encoder decode → pressure loop (on its tick) → speed loop (on its
+//! tick) → current loop → fault conditions → supervisor. A fault found in a call returns
+//! disabled PWM from that same call.
+//!
+//! Start-up without calibration: the current offsets start at the configured zero
+//! (`sensors.current_zero_lsb`, mid-scale) and the encoder offset at
+//! `sensors.encoder_offset_rad`, so Speed and Pressure can be entered straight from
+//! Disabled (the simulator does). Calibrating measures both and replaces them; it ends in
+//! Disabled.
+//!
+//! Entering Pressure holds the measured pressure until a pressure setpoint is commanded;
+//! the pressure loop starts bumplessly from the present speed reference. Entering Speed
+//! uses the last commanded speed setpoint (0 if none).
+
+use crate::config::{whole_ratio, Config};
+use crate::current_loop::{CurrentLoop, CurrentLoopState};
+use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
+use crate::io::{Measurements, Outputs};
+use crate::pressure_loop::PressureLoop;
+use crate::speed_loop::SpeedLoop;
+use crate::supervisor::{Conditions, FaultCode, Mode, ModeRefusal, Supervisor};
+use crate::telemetry::TelemetryFrame;
+use crate::transforms::{wrap_2pi, Dq};
+use core::fmt;
+
+/// A command to the drive (CAN or host).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Command {
+    /// Requests a mode.
+    SetMode(Mode),
+    /// Pressure setpoint (gauge). [Pa]
+    SetPressure {
+        /// Setpoint. [Pa]
+        pa: f32,
+    },
+    /// Speed setpoint. [rad/s]
+    SetSpeed {
+        /// Setpoint. [rad/s]
+        rad_s: f32,
+    },
+    /// Clears a latched fault once its cause is gone.
+    ClearFaults,
+    /// Keeps the command timeout from expiring.
+    Heartbeat,
+}
+
+/// Why a command was refused. Its [`CommandError::code`] shows in telemetry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CommandError {
+    /// Pressure setpoint outside `[min_pa, max_pa]` (`pressure.setpoint_min_pa`,
+    /// `pressure.setpoint_max_pa`), or not finite.
+    PressureOutOfRange {
+        /// Lower bound. [Pa]
+        min_pa: f32,
+        /// Upper bound. [Pa]
+        max_pa: f32,
+    },
+    /// Speed setpoint magnitude above `max_rad_s` (`speed.speed_limit_rad_s`), or not
+    /// finite.
+    SpeedOutOfRange {
+        /// Bound on the magnitude. [rad/s]
+        max_rad_s: f32,
+    },
+    /// Mode request refused.
+    Mode(ModeRefusal),
+    /// ClearFaults refused: the fault's cause is still present.
+    CausePresent(FaultCode),
+}
+
+impl CommandError {
+    /// Status code for telemetry and CAN replies (0 means accepted).
+    pub fn code(&self) -> u8 {
+        match self {
+            CommandError::PressureOutOfRange { .. } => 1,
+            CommandError::SpeedOutOfRange { .. } => 2,
+            CommandError::Mode(ModeRefusal::Faulted(_)) => 3,
+            CommandError::Mode(ModeRefusal::ConditionPresent(_)) => 4,
+            CommandError::Mode(ModeRefusal::Transition { .. }) => 5,
+            CommandError::CausePresent(_) => 6,
+        }
+    }
+}
+
+impl fmt::Display for CommandError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CommandError::PressureOutOfRange { min_pa, max_pa } => write!(
+                f,
+                "pressure setpoint outside [{min_pa} Pa, {max_pa} Pa] (pressure.setpoint_min_pa..=pressure.setpoint_max_pa)"
+            ),
+            CommandError::SpeedOutOfRange { max_rad_s } => write!(
+                f,
+                "speed setpoint magnitude above {max_rad_s} rad/s (speed.speed_limit_rad_s)"
+            ),
+            CommandError::Mode(ModeRefusal::Faulted(x)) => {
+                write!(f, "mode refused: {x} is latched (clear it first)")
+            }
+            CommandError::Mode(ModeRefusal::ConditionPresent(x)) => {
+                write!(f, "mode refused: condition present ({x})")
+            }
+            CommandError::Mode(ModeRefusal::Transition { from, to }) => {
+                write!(f, "mode refused: {from:?} -> {to:?} (go through Disabled)")
+            }
+            CommandError::CausePresent(x) => write!(f, "clear refused: cause still present ({x})"),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Calibration {
+    Offsets { n: u32, sums: [u32; 3] },
+    Align { n: u32 },
+}
+
+/// Constants derived once from the configuration.
+#[derive(Clone, Copy, Debug)]
+struct Derived {
+    pwm_hz: f64,
+    speed_div: u32,
+    pressure_div: u32,
+    timeout_calls: u32,
+    offset_calls: u32,
+    align_calls: u32,
+    pole_pairs: f32,
+}
+
+/// The drive controller.
+#[derive(Clone, Debug)]
+pub struct Controller {
+    cfg: Config,
+    d: Derived,
+    current: CurrentLoop,
+    speed: SpeedLoop,
+    pressure: PressureLoop,
+    encoder: Encoder,
+    sup: Supervisor,
+    calibration: Calibration,
+    active_last_call: bool,
+    samples: u64,
+    speed_tick: u32,
+    pressure_tick: u32,
+    p_sum: u32,
+    p_n: u32,
+    since_command: u32,
+    speed_setpoint: f32,
+    pressure_target: Option<f32>,
+    speed_ref: f32,
+    iq_ref: f32,
+    id_ref: f32,
+    p_pa: f32,
+    theta_m: f32,
+    state: CurrentLoopState,
+    command_status: u8,
+    calibrated: bool,
+}
+
+impl Controller {
+    /// From an already validated configuration (see [`Config::validate`]).
+    pub fn new(config: &Config) -> Controller {
+        let r = &config.rates;
+        let pwm = r.pwm_hz.max(1.0);
+        let calls = |s: f32| ((s * pwm) as u32).max(1);
+        let max_step = max_step_counts(
+            config.limits.encoder_plausible_speed_rad_s,
+            pwm,
+            config.sensors.encoder_counts_per_rev,
+        );
+        Controller {
+            cfg: *config,
+            d: Derived {
+                pwm_hz: pwm as f64,
+                speed_div: whole_ratio(pwm, r.speed_loop_hz).unwrap_or(1),
+                pressure_div: whole_ratio(pwm, r.pressure_loop_hz).unwrap_or(1),
+                timeout_calls: calls(config.limits.command_timeout_s),
+                offset_calls: calls(config.calibration.offset_time_s),
+                align_calls: calls(config.calibration.alignment_time_s),
+                pole_pairs: config.motor.pole_pairs as f32,
+            },
+            current: CurrentLoop::new(config),
+            speed: SpeedLoop::new(config),
+            pressure: PressureLoop::new(config),
+            encoder: Encoder::new(
+                config.sensors.encoder_counts_per_rev,
+                config.motor.pole_pairs,
+                config.sensors.encoder_offset_rad,
+                max_step,
+            ),
+            sup: Supervisor::new(),
+            calibration: Calibration::Offsets { n: 0, sums: [0; 3] },
+            active_last_call: false,
+            samples: 0,
+            speed_tick: 0,
+            pressure_tick: 0,
+            p_sum: 0,
+            p_n: 0,
+            since_command: 0,
+            speed_setpoint: 0.0,
+            pressure_target: None,
+            speed_ref: 0.0,
+            iq_ref: 0.0,
+            id_ref: 0.0,
+            p_pa: 0.0,
+            theta_m: 0.0,
+            state: CurrentLoopState::default(),
+            command_status: 0,
+            calibrated: false,
+        }
+    }
+
+    /// Configuration in use.
+    pub fn config(&self) -> &Config {
+        &self.cfg
+    }
+
+    /// Current mode.
+    pub fn mode(&self) -> Mode {
+        self.sup.mode()
+    }
+
+    /// Latched fault.
+    pub fn fault(&self) -> Option<FaultCode> {
+        self.sup.fault()
+    }
+
+    /// Fault conditions present in the last sample (latched or not).
+    pub fn conditions(&self) -> Conditions {
+        self.sup.conditions()
+    }
+
+    /// True once a calibration has completed.
+    pub fn is_calibrated(&self) -> bool {
+        self.calibrated
+    }
+
+    /// Zero-current ADC results in use. [counts]
+    pub fn current_offsets(&self) -> [f32; 3] {
+        self.current.offsets()
+    }
+
+    /// Encoder electrical offset in use. [rad]
+    pub fn encoder_offset(&self) -> f32 {
+        self.encoder.offset()
+    }
+
+    /// Watchdog entry point: the application calls this when a control loop overran. The
+    /// fault latches at once and the mode drops to Disabled; the next
+    /// [`Controller::on_current_sample`] returns disabled PWM (the application should also
+    /// disable the bridge itself).
+    pub fn report_overrun(&mut self) {
+        self.sup.trip(FaultCode::Watchdog);
+    }
+
+    /// Pressure from the ADC result (gauge). [Pa]
+    #[inline]
+    fn pressure_pa(&self, counts: f32) -> f32 {
+        (counts - self.cfg.sensors.pressure_zero_lsb) * self.cfg.sensors.pressure_pa_per_lsb
+    }
+
+    /// The current-loop ISR body: infallible, allocation-free.
+    pub fn on_current_sample(&mut self, m: &Measurements) -> Outputs {
+        self.samples = self.samples.wrapping_add(1);
+        self.since_command = self.since_command.saturating_add(1);
+        let enc_event = self.encoder.update(m.encoder_count, m.encoder_index);
+        self.theta_m = self.encoder.mechanical_angle(m.encoder_count);
+        let mut theta_e = self.encoder.electrical_angle(m.encoder_count);
+        self.p_pa = self.pressure_pa(m.adc_pressure as f32);
+        self.p_sum = self.p_sum.saturating_add(m.adc_pressure as u32);
+        self.p_n += 1;
+
+        let mode = self.sup.mode();
+        if mode.is_active() && !self.active_last_call {
+            self.on_enter_active(mode);
+        }
+
+        // Pressure loop tick (before the speed loop so it uses the fresh reference).
+        self.pressure_tick += 1;
+        if self.pressure_tick >= self.d.pressure_div {
+            self.pressure_tick = 0;
+            let mean = self.pressure_pa(self.p_sum as f32 / self.p_n.max(1) as f32);
+            self.p_sum = 0;
+            self.p_n = 0;
+            if mode == Mode::Pressure {
+                if let Some(t) = self.pressure_target {
+                    self.pressure.set_target(t);
+                }
+                self.speed_ref = self.pressure.step(mean);
+            }
+        }
+        // Speed loop tick.
+        self.speed_tick += 1;
+        if self.speed_tick >= self.d.speed_div {
+            self.speed_tick = 0;
+            let w = self.speed.measure(self.encoder.position());
+            match mode {
+                Mode::Speed => {
+                    self.speed_ref = self.speed_setpoint;
+                    self.iq_ref = self.speed.step(self.speed_ref, w);
+                }
+                Mode::Pressure => self.iq_ref = self.speed.step(self.speed_ref, w),
+                _ => {}
+            }
+        }
+
+        // Current references by mode; calibration may hold the bridge off or force θ_e.
+        let mut bridge = mode.is_active();
+        let mut conditions = Conditions::default();
+        match mode {
+            Mode::Speed | Mode::Pressure => self.id_ref = 0.0,
+            Mode::Calibrating => {
+                let (on, theta, fault) = self.calibrate(m);
+                bridge = on;
+                theta_e = theta;
+                conditions.set(FaultCode::CurrentOffset, fault);
+            }
+            Mode::Disabled => {}
+        }
+
+        let omega_e = self.speed.speed() * self.d.pole_pairs;
+        self.state = if bridge {
+            let i_ref = Dq {
+                d: self.id_ref,
+                q: self.iq_ref,
+            };
+            self.current.step(m, theta_e, i_ref, omega_e)
+        } else {
+            CurrentLoopState {
+                i_abc: self.current.phase_currents(m),
+                u_dc: m.adc_dc_link as f32 * self.cfg.sensors.dc_link_v_per_lsb,
+                duties: [0.5; 3],
+                ..CurrentLoopState::default()
+            }
+        };
+
+        // Fault conditions of this sample.
+        let l = &self.cfg.limits;
+        let s = &self.cfg.sensors;
+        let i_max = self.state.i_abc.iter().fold(0.0f32, |a, i| a.max(i.abs()));
+        // NaN currents count as over-current.
+        let over_current = i_max.is_nan() || i_max > l.over_current_a;
+        conditions.set(FaultCode::PhaseOverCurrent, over_current);
+        conditions.set(
+            FaultCode::DcLinkOverVoltage,
+            self.state.u_dc > l.over_voltage_v,
+        );
+        conditions.set(
+            FaultCode::DcLinkUnderVoltage,
+            self.state.u_dc < l.under_voltage_v,
+        );
+        let open = m.adc_pressure < s.pressure_open_wire_lsb;
+        let short = m.adc_pressure > s.pressure_short_lsb;
+        conditions.set(FaultCode::PressureSensorOpenWire, open);
+        conditions.set(FaultCode::PressureSensorShort, short);
+        conditions.set(
+            FaultCode::OverPressure,
+            !open && !short && self.p_pa > l.over_pressure_pa,
+        );
+        conditions.set(FaultCode::EncoderJump, enc_event == EncoderEvent::Jump);
+        conditions.set(
+            FaultCode::EncoderIndexLost,
+            enc_event == EncoderEvent::IndexLost,
+        );
+        conditions.set(
+            FaultCode::OverSpeed,
+            self.speed.speed().abs() > l.over_speed_rad_s,
+        );
+        conditions.set(
+            FaultCode::CommandTimeout,
+            mode.is_active() && self.since_command > self.d.timeout_calls,
+        );
+
+        let still_on = self.sup.check(conditions);
+        self.active_last_call = self.sup.mode().is_active();
+        if still_on && bridge {
+            Outputs {
+                duties: self.state.duties,
+                pwm_enabled: true,
+            }
+        } else {
+            if !still_on {
+                self.state.u_dq = Dq::default();
+                self.state.duties = [0.5; 3];
+            }
+            Outputs::DISABLED
+        }
+    }
+
+    /// Resets the loops for a start from rest in `mode`.
+    fn on_enter_active(&mut self, mode: Mode) {
+        self.current.reset();
+        self.speed.reset(self.encoder.position(), 0.0);
+        self.speed_ref = 0.0;
+        self.iq_ref = 0.0;
+        self.id_ref = 0.0;
+        self.speed_tick = 0;
+        if mode == Mode::Pressure {
+            self.pressure.reset(self.p_pa, 0.0);
+            self.pressure
+                .set_target(self.pressure_target.unwrap_or(self.p_pa));
+        }
+        if mode == Mode::Calibrating {
+            self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
+        }
+    }
+
+    /// One calibration sample: returns (bridge on, electrical angle to use, offset fault).
+    fn calibrate(&mut self, m: &Measurements) -> (bool, f32, bool) {
+        match self.calibration {
+            Calibration::Offsets { n, sums } => {
+                let mut sums = sums;
+                for (s, a) in sums.iter_mut().zip(m.adc_phase_current) {
+                    *s = s.saturating_add(a as u32);
+                }
+                let n = n + 1;
+                if n >= self.d.offset_calls {
+                    let offsets = sums.map(|s| s as f32 / n as f32);
+                    let zero = self.cfg.sensors.current_zero_lsb;
+                    let bad = offsets
+                        .iter()
+                        .any(|o| (o - zero).abs() > self.cfg.calibration.offset_max_lsb);
+                    if bad {
+                        return (false, 0.0, true);
+                    }
+                    self.current.set_offsets(offsets);
+                    self.current.reset();
+                    self.calibration = Calibration::Align { n: 0 };
+                } else {
+                    self.calibration = Calibration::Offsets { n, sums };
+                }
+                (false, 0.0, false)
+            }
+            Calibration::Align { n } => {
+                self.id_ref = self.cfg.calibration.alignment_current_a;
+                self.iq_ref = 0.0;
+                let n = n + 1;
+                if n >= self.d.align_calls {
+                    // The rotor's d axis now sits at θ_e = 0: the count's electrical angle
+                    // is the offset.
+                    let raw =
+                        self.encoder.electrical_angle(m.encoder_count) + self.encoder.offset();
+                    self.encoder.set_offset(wrap_2pi(raw));
+                    self.calibrated = true;
+                    self.id_ref = 0.0;
+                    self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
+                    // Disabled is always granted.
+                    let _ = self.sup.request(Mode::Disabled);
+                    return (false, 0.0, false);
+                }
+                self.calibration = Calibration::Align { n };
+                (true, 0.0, false)
+            }
+        }
+    }
+
+    /// Takes a command. Any command (accepted or not) restarts the command timeout; a
+    /// refusal's code shows in telemetry until the next accepted command.
+    pub fn command(&mut self, c: Command) -> Result<(), CommandError> {
+        self.since_command = 0;
+        let result = self.apply(c);
+        self.command_status = match &result {
+            Ok(()) => 0,
+            Err(e) => e.code(),
+        };
+        result
+    }
+
+    fn apply(&mut self, c: Command) -> Result<(), CommandError> {
+        match c {
+            Command::Heartbeat => Ok(()),
+            Command::SetPressure { pa } => {
+                let p = &self.cfg.pressure;
+                if pa.is_nan() || pa < p.setpoint_min_pa || pa > p.setpoint_max_pa {
+                    return Err(CommandError::PressureOutOfRange {
+                        min_pa: p.setpoint_min_pa,
+                        max_pa: p.setpoint_max_pa,
+                    });
+                }
+                self.pressure_target = Some(pa);
+                self.pressure.set_target(pa);
+                Ok(())
+            }
+            Command::SetSpeed { rad_s } => {
+                let max = self.cfg.speed.speed_limit_rad_s;
+                if rad_s.is_nan() || rad_s.abs() > max {
+                    return Err(CommandError::SpeedOutOfRange { max_rad_s: max });
+                }
+                self.speed_setpoint = rad_s;
+                Ok(())
+            }
+            Command::ClearFaults => {
+                self.sup.clear().map_err(CommandError::CausePresent)?;
+                self.encoder.rearm();
+                Ok(())
+            }
+            Command::SetMode(mode) => {
+                let from = self.sup.mode();
+                self.sup.request(mode).map_err(CommandError::Mode)?;
+                if from != mode && mode == Mode::Pressure && from == Mode::Speed {
+                    // Bumpless hand-over: the pressure loop starts from the present speed
+                    // reference.
+                    self.pressure.reset(self.p_pa, self.speed_ref);
+                    self.pressure
+                        .set_target(self.pressure_target.unwrap_or(self.p_pa));
+                }
+                if from != mode && mode == Mode::Calibrating {
+                    self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Telemetry of the last sample.
+    pub fn telemetry(&self) -> TelemetryFrame {
+        let mode = self.sup.mode();
+        let p_ref = match (mode, self.pressure_target) {
+            (Mode::Pressure, _) => self.pressure.setpoint(),
+            (_, Some(t)) => t,
+            (_, None) => 0.0,
+        };
+        TelemetryFrame {
+            t_s: self.samples as f64 / self.d.pwm_hz,
+            p_ref_pa: p_ref,
+            p_pa: self.p_pa,
+            speed_rad_s: self.speed.speed(),
+            iq_a: self.state.i_dq.q,
+            id_a: self.state.i_dq.d,
+            theta_m_rad: self.theta_m,
+            speed_ref_rad_s: self.speed_ref,
+            iq_ref_a: self.iq_ref,
+            ud_v: self.state.u_dq.d,
+            uq_v: self.state.u_dq.q,
+            udc_v: self.state.u_dc,
+            mode,
+            fault: self.sup.fault(),
+            command_status: self.command_status,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

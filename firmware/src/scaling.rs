@@ -1,0 +1,85 @@
+//! Fixed-point conversions at the peripheral boundary: raw ADC results to normalised
+//! fractions of full scale, and duties to timer compare values.
+//!
+//! The control core computes in f32 (the Cortex-M4F has a single-precision FPU), but the
+//! peripherals speak integers. These helpers make the two integer interfaces exact and
+//! saturating with the `fixed` crate: a 12-bit right-aligned ADC result is exactly a U0F16
+//! fraction once shifted by four bits, a bipolar current reading about its zero is an
+//! I1F15, and a duty in [0, 1] is a U1F15 whose product with the timer period rounds
+//! correctly and never exceeds the period.
+
+use fixed::types::{I1F15, U0F16, U1F15};
+
+/// A 12-bit right-aligned ADC result as a fraction of full scale (4095 → 0.99976).
+#[inline]
+pub fn adc12_fraction(counts: u16) -> U0F16 {
+    U0F16::from_bits(counts.min(4095) << 4)
+}
+
+/// A 16-bit (oversampled) ADC result as a fraction of full scale.
+#[inline]
+pub fn adc16_fraction(counts: u16) -> U0F16 {
+    U0F16::from_bits(counts)
+}
+
+/// A bipolar 12-bit reading about `zero` as a signed fraction of half scale (±2048 counts
+/// → ±1, saturating just below +1).
+#[inline]
+pub fn adc12_bipolar(counts: u16, zero: u16) -> I1F15 {
+    let d = (counts.min(4095) as i32 - zero.min(4095) as i32) << 4;
+    I1F15::from_bits(d.clamp(i16::MIN as i32, i16::MAX as i32) as i16)
+}
+
+/// Timer compare value for `duty` (clamped to [0, 1]; NaN → 0) with `period` ticks
+/// (the timer's ARR for centre-aligned PWM): round(duty·period), at most `period`.
+#[inline]
+pub fn duty_to_compare(duty: f32, period: u16) -> u16 {
+    let d = if duty.is_nan() {
+        0.0
+    } else {
+        duty.clamp(0.0, 1.0)
+    };
+    let d = U1F15::saturating_from_num(d);
+    let product = d.to_bits() as u32 * period as u32 + (1 << 14);
+    ((product >> 15) as u16).min(period)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn adc_fractions() {
+        assert_eq!(adc12_fraction(0).to_num::<f32>(), 0.0);
+        assert_eq!(adc12_fraction(2048).to_num::<f32>(), 0.5);
+        assert_eq!(adc16_fraction(32768).to_num::<f32>(), 0.5);
+        assert_eq!(adc12_bipolar(2048, 2048).to_num::<f32>(), 0.0);
+        assert_eq!(adc12_bipolar(1024, 2048).to_num::<f32>(), -0.5);
+        assert_eq!(adc12_bipolar(0, 2048).to_num::<f32>(), -1.0);
+        assert!(adc12_bipolar(4095, 2048).to_num::<f32>() < 1.0);
+        // Phase current: fraction of half scale × 50 A (100 A over 4096 counts).
+        let i = adc12_bipolar(2048 + 410, 2048).to_num::<f32>() * 50.0;
+        assert!((i - 410.0 * 100.0 / 4096.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn compare_values_round_and_saturate() {
+        for period in [1u16, 100, 4250, 8500, 65535] {
+            for k in 0..=64 {
+                let duty = k as f32 / 64.0;
+                let want = libm::roundf(duty * period as f32);
+                let got = duty_to_compare(duty, period) as f32;
+                assert!(
+                    (got - want).abs() <= 1.0,
+                    "{duty} {period}: {got} vs {want}"
+                );
+                assert!(got <= period as f32);
+            }
+        }
+        assert_eq!(duty_to_compare(1.0, 8500), 8500);
+        assert_eq!(duty_to_compare(2.0, 8500), 8500);
+        assert_eq!(duty_to_compare(-1.0, 8500), 0);
+        assert_eq!(duty_to_compare(f32::NAN, 8500), 0);
+        assert_eq!(duty_to_compare(0.5, 8500), 4250);
+    }
+}

@@ -1,0 +1,353 @@
+//! Supervisor: the operating modes and the latched faults of the drive.
+//!
+//! Every current-loop call the controller hands the supervisor the conditions it measured;
+//! the first fault condition seen in an active mode latches its [`FaultCode`], drops the
+//! mode to [`Mode::Disabled`] and the controller returns disabled PWM from that same call.
+//! A latched fault is cleared only by command ([`Supervisor::clear`]), and only once its
+//! cause is gone; event faults (encoder jump, command timeout, watchdog) have no lasting
+//! cause, so the clear command itself is enough.
+//!
+//! Conditions are evaluated in every mode (so telemetry and the clear check see them) but
+//! latch only while the bridge is on (Calibrating, Speed, Pressure): a drive at rest with
+//! the DC link off is not faulted, and entering an active mode is refused while any
+//! condition is present.
+
+use core::fmt;
+
+/// Operating mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[repr(u8)]
+pub enum Mode {
+    /// Bridge off.
+    #[default]
+    Disabled = 0,
+    /// Current-offset calibration (bridge off) then encoder alignment (d-axis current).
+    Calibrating = 1,
+    /// Speed control from the speed setpoint.
+    Speed = 2,
+    /// Pressure control from the pressure setpoint.
+    Pressure = 3,
+}
+
+impl Mode {
+    /// Wire/telemetry code.
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// From the wire/telemetry code.
+    pub fn from_code(code: u8) -> Option<Mode> {
+        match code {
+            0 => Some(Mode::Disabled),
+            1 => Some(Mode::Calibrating),
+            2 => Some(Mode::Speed),
+            3 => Some(Mode::Pressure),
+            _ => None,
+        }
+    }
+
+    /// True when the bridge may be on.
+    pub fn is_active(self) -> bool {
+        self != Mode::Disabled
+    }
+}
+
+/// Latched fault codes (telemetry code in brackets; 0 = no fault).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum FaultCode {
+    /// A phase current above `limits.over_current_a`. (1)
+    PhaseOverCurrent = 1,
+    /// DC link above `limits.over_voltage_v`. (2)
+    DcLinkOverVoltage = 2,
+    /// DC link below `limits.under_voltage_v`. (3)
+    DcLinkUnderVoltage = 3,
+    /// Pressure above `limits.over_pressure_pa`. (4)
+    OverPressure = 4,
+    /// Pressure ADC below the open-wire threshold. (5)
+    PressureSensorOpenWire = 5,
+    /// Pressure ADC above the short-circuit threshold. (6)
+    PressureSensorShort = 6,
+    /// Encoder count moved implausibly far in one period. (7)
+    EncoderJump = 7,
+    /// Encoder index missing for more than a revolution, or far from count 0. (8)
+    EncoderIndexLost = 8,
+    /// Speed magnitude above `limits.over_speed_rad_s`. (9)
+    OverSpeed = 9,
+    /// No command within `limits.command_timeout_s` in an active mode. (10)
+    CommandTimeout = 10,
+    /// The application reported a control-loop overrun. (11)
+    Watchdog = 11,
+    /// Calibrated current offsets out of range. (12)
+    CurrentOffset = 12,
+}
+
+impl FaultCode {
+    /// All codes, in bit order.
+    pub const ALL: [FaultCode; 12] = [
+        FaultCode::PhaseOverCurrent,
+        FaultCode::DcLinkOverVoltage,
+        FaultCode::DcLinkUnderVoltage,
+        FaultCode::OverPressure,
+        FaultCode::PressureSensorOpenWire,
+        FaultCode::PressureSensorShort,
+        FaultCode::EncoderJump,
+        FaultCode::EncoderIndexLost,
+        FaultCode::OverSpeed,
+        FaultCode::CommandTimeout,
+        FaultCode::Watchdog,
+        FaultCode::CurrentOffset,
+    ];
+
+    /// Telemetry code (1..=12).
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// From the telemetry code.
+    pub fn from_code(code: u8) -> Option<FaultCode> {
+        FaultCode::ALL.iter().copied().find(|f| f.code() == code)
+    }
+
+    /// Bit in a [`Conditions`] mask.
+    pub fn bit(self) -> u16 {
+        1 << (self as u8 - 1)
+    }
+
+    /// True for faults that are events without a lasting cause.
+    pub fn is_event(self) -> bool {
+        matches!(
+            self,
+            FaultCode::EncoderJump
+                | FaultCode::EncoderIndexLost
+                | FaultCode::CommandTimeout
+                | FaultCode::Watchdog
+                | FaultCode::CurrentOffset
+        )
+    }
+}
+
+impl fmt::Display for FaultCode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            FaultCode::PhaseOverCurrent => "phase over-current",
+            FaultCode::DcLinkOverVoltage => "DC-link over-voltage",
+            FaultCode::DcLinkUnderVoltage => "DC-link under-voltage",
+            FaultCode::OverPressure => "over-pressure",
+            FaultCode::PressureSensorOpenWire => "pressure sensor open wire",
+            FaultCode::PressureSensorShort => "pressure sensor short",
+            FaultCode::EncoderJump => "encoder jump",
+            FaultCode::EncoderIndexLost => "encoder index lost",
+            FaultCode::OverSpeed => "over-speed",
+            FaultCode::CommandTimeout => "command timeout",
+            FaultCode::Watchdog => "watchdog (control-loop overrun)",
+            FaultCode::CurrentOffset => "current offset out of range",
+        };
+        write!(f, "fault {}: {}", self.code(), s)
+    }
+}
+
+/// Set of fault conditions present in one sample (bit = [`FaultCode::bit`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Conditions(pub u16);
+
+impl Conditions {
+    /// Adds `f` when `present`.
+    #[inline]
+    pub fn set(&mut self, f: FaultCode, present: bool) {
+        if present {
+            self.0 |= f.bit();
+        }
+    }
+
+    /// True when `f` is present.
+    pub fn has(self, f: FaultCode) -> bool {
+        self.0 & f.bit() != 0
+    }
+
+    /// The present condition with the lowest code (the most basic cause first).
+    pub fn first(self) -> Option<FaultCode> {
+        FaultCode::ALL.iter().copied().find(|f| self.has(*f))
+    }
+}
+
+/// Mode and latched-fault state.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Supervisor {
+    mode: Mode,
+    fault: Option<FaultCode>,
+    present: Conditions,
+}
+
+impl Supervisor {
+    /// Disabled, no fault.
+    pub fn new() -> Supervisor {
+        Supervisor::default()
+    }
+
+    /// Current mode.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Latched fault.
+    pub fn fault(&self) -> Option<FaultCode> {
+        self.fault
+    }
+
+    /// Conditions of the last sample.
+    pub fn conditions(&self) -> Conditions {
+        self.present
+    }
+
+    /// Takes one sample's conditions; latches the first one while active. Returns true when
+    /// the bridge may stay on after this call.
+    #[inline]
+    pub fn check(&mut self, conditions: Conditions) -> bool {
+        self.present = conditions;
+        if self.mode.is_active() {
+            if let Some(f) = conditions.first() {
+                self.trip(f);
+            }
+        }
+        self.fault.is_none() && self.mode.is_active()
+    }
+
+    /// Latches `f` (keeps an earlier fault) and disables the bridge.
+    pub fn trip(&mut self, f: FaultCode) {
+        if self.fault.is_none() {
+            self.fault = Some(f);
+        }
+        self.mode = Mode::Disabled;
+    }
+
+    /// Clears the latched fault if its cause is gone (event faults: always). On refusal,
+    /// returns the fault whose cause is still present.
+    pub fn clear(&mut self) -> Result<(), FaultCode> {
+        match self.fault {
+            Some(f) if !f.is_event() && self.present.has(f) => Err(f),
+            _ => {
+                self.fault = None;
+                Ok(())
+            }
+        }
+    }
+
+    /// Requests `mode`. Disabled is always granted; an active mode needs no latched fault
+    /// and no present condition; Calibrating is entered only from Disabled; Speed and
+    /// Pressure switch between each other directly.
+    pub fn request(&mut self, mode: Mode) -> Result<(), ModeRefusal> {
+        if mode == Mode::Disabled {
+            self.mode = mode;
+            return Ok(());
+        }
+        if let Some(f) = self.fault {
+            return Err(ModeRefusal::Faulted(f));
+        }
+        if let Some(f) = self.present.first() {
+            return Err(ModeRefusal::ConditionPresent(f));
+        }
+        let ok = matches!(
+            (self.mode, mode),
+            (Mode::Disabled, _)
+                | (Mode::Calibrating, Mode::Calibrating)
+                | (Mode::Speed | Mode::Pressure, Mode::Speed | Mode::Pressure)
+        );
+        if ok {
+            self.mode = mode;
+            Ok(())
+        } else {
+            Err(ModeRefusal::Transition {
+                from: self.mode,
+                to: mode,
+            })
+        }
+    }
+}
+
+/// Why a mode request was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeRefusal {
+    /// A fault is latched.
+    Faulted(FaultCode),
+    /// A fault condition is present now.
+    ConditionPresent(FaultCode),
+    /// The transition is not allowed (go through Disabled).
+    Transition {
+        /// Current mode.
+        from: Mode,
+        /// Requested mode.
+        to: Mode,
+    },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_round_trip_and_bits_are_distinct() {
+        let mut seen = 0u16;
+        for f in FaultCode::ALL {
+            assert_eq!(FaultCode::from_code(f.code()), Some(f));
+            assert_eq!(seen & f.bit(), 0);
+            seen |= f.bit();
+        }
+        assert_eq!(FaultCode::from_code(0), None);
+        for m in [
+            Mode::Disabled,
+            Mode::Calibrating,
+            Mode::Speed,
+            Mode::Pressure,
+        ] {
+            assert_eq!(Mode::from_code(m.code()), Some(m));
+        }
+    }
+
+    #[test]
+    fn latches_and_clears_only_when_the_cause_is_gone() {
+        let mut s = Supervisor::new();
+        s.request(Mode::Speed).unwrap();
+        let mut c = Conditions::default();
+        c.set(FaultCode::OverPressure, true);
+        assert!(!s.check(c));
+        assert_eq!(s.fault(), Some(FaultCode::OverPressure));
+        assert_eq!(s.mode(), Mode::Disabled);
+        // Still present: refused, and mode requests too.
+        assert_eq!(s.clear(), Err(FaultCode::OverPressure));
+        assert_eq!(
+            s.request(Mode::Speed),
+            Err(ModeRefusal::Faulted(FaultCode::OverPressure))
+        );
+        // Gone: the fault stays latched until cleared.
+        assert!(!s.check(Conditions::default()));
+        assert_eq!(s.fault(), Some(FaultCode::OverPressure));
+        assert_eq!(s.clear(), Ok(()));
+        assert_eq!(s.fault(), None);
+        assert_eq!(s.mode(), Mode::Disabled);
+    }
+
+    #[test]
+    fn transitions() {
+        let mut s = Supervisor::new();
+        assert!(s.request(Mode::Pressure).is_ok());
+        assert!(s.request(Mode::Speed).is_ok());
+        assert_eq!(
+            s.request(Mode::Calibrating),
+            Err(ModeRefusal::Transition {
+                from: Mode::Speed,
+                to: Mode::Calibrating
+            })
+        );
+        let mut c = Conditions::default();
+        c.set(FaultCode::DcLinkUnderVoltage, true);
+        s.request(Mode::Disabled).unwrap();
+        // Disabled: the condition is seen but does not latch; entering a mode is refused.
+        assert!(!s.check(c));
+        assert_eq!(s.fault(), None);
+        assert_eq!(
+            s.request(Mode::Speed),
+            Err(ModeRefusal::ConditionPresent(FaultCode::DcLinkUnderVoltage))
+        );
+    }
+}
