@@ -1,0 +1,20 @@
+//! The `eha` command's library: everything the binary does, reachable from the tests and
+//! benchmarks too (the `eha` binary in `main.rs` only calls [`cli::main`]).
+//!
+//! - [`cli`]: argument parsing (the subcommands of `shared/contracts/eha-cli.md`), error
+//!   reporting with exit status 2 for bad input and 1 for anything else.
+//! - [`bench_log`]: the bench-log CSV contract (`shared/contracts/bench-log.md`), read and
+//!   written.
+//! - [`rig_file`]: the rig-file format, TOML of [`plant_model::Rig`].
+//! - [`study`]: the paper's accumulator study (Section 4.3).
+//! - [`simulate`]: the closed-loop runs behind `demo`, `simulate` and `sweep-precharge`.
+//! - [`pending`]: the subcommands of other issues, routed but not built yet.
+//! - [`atomic_file`]: output files appear whole or not at all.
+
+pub mod atomic_file;
+pub mod bench_log;
+pub mod cli;
+pub mod pending;
+pub mod rig_file;
+pub mod simulate;
+pub mod study;

@@ -1,0 +1,37 @@
+//! Placeholder for the subcommands of other issues: commissioning and tuning (issue 8),
+//! ingest and diagnosis (issue 5). Each moves to its own module when its issue lands.
+
+use crate::cli::{CliError, CommissionArgs, DiagnoseArgs, IngestArgs, TuneArgs};
+use plant_model::Rig;
+
+/// `eha commission`.
+pub fn run_commission(_rig: &Rig, _args: &CommissionArgs) -> Result<(), CliError> {
+    Err(CliError::NotYetImplemented {
+        command: "commission",
+        issue: 8,
+    })
+}
+
+/// `eha tune`.
+pub fn run_tune(_rig: &Rig, _args: &TuneArgs) -> Result<(), CliError> {
+    Err(CliError::NotYetImplemented {
+        command: "tune",
+        issue: 8,
+    })
+}
+
+/// `eha ingest`.
+pub fn run_ingest(_rig: &Rig, _args: &IngestArgs) -> Result<(), CliError> {
+    Err(CliError::NotYetImplemented {
+        command: "ingest",
+        issue: 5,
+    })
+}
+
+/// `eha diagnose`.
+pub fn run_diagnose(_rig: &Rig, _args: &DiagnoseArgs) -> Result<(), CliError> {
+    Err(CliError::NotYetImplemented {
+        command: "diagnose",
+        issue: 5,
+    })
+}
