@@ -1,5 +1,7 @@
 //! Placeholder for the subcommands of other issues: commissioning and tuning (issue 8),
 //! ingest and diagnosis (issue 5). Each moves to its own module when its issue lands.
+//! Those that take a bench log read and check it first, so a bad log is reported (exit 2)
+//! already, before the missing feature is.
 
 use crate::cli::{CliError, CommissionArgs, DiagnoseArgs, IngestArgs, TuneArgs};
 use plant_model::Rig;
@@ -13,7 +15,8 @@ pub fn run_commission(_rig: &Rig, _args: &CommissionArgs) -> Result<(), CliError
 }
 
 /// `eha tune`.
-pub fn run_tune(_rig: &Rig, _args: &TuneArgs) -> Result<(), CliError> {
+pub fn run_tune(_rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
+    crate::bench_log::read(&args.log)?;
     Err(CliError::NotYetImplemented {
         command: "tune",
         issue: 8,
@@ -29,7 +32,8 @@ pub fn run_ingest(_rig: &Rig, _args: &IngestArgs) -> Result<(), CliError> {
 }
 
 /// `eha diagnose`.
-pub fn run_diagnose(_rig: &Rig, _args: &DiagnoseArgs) -> Result<(), CliError> {
+pub fn run_diagnose(_rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
+    crate::bench_log::read(&args.log)?;
     Err(CliError::NotYetImplemented {
         command: "diagnose",
         issue: 5,

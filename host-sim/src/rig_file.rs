@@ -23,10 +23,13 @@ pub enum RigFileError {
         source: std::io::Error,
     },
     /// Not TOML, or a value of the wrong type, or a parameter missing.
-    #[error("rig file `{}`: {message}", file.display())]
+    #[error("rig file `{}`{}: {message}", file.display(), key.as_ref().map(|k| format!(", key `{k}`")).unwrap_or_default())]
     Syntax {
         /// The file.
         file: PathBuf,
+        /// Dotted path of the key whose value is wrong, when the error sits on a
+        /// `key = value` line.
+        key: Option<String>,
         /// The TOML parser's message: line, column, the offending text and the key.
         message: String,
         /// 1-based line of the error, when the parser gives one.
@@ -63,18 +66,23 @@ pub fn load(path: &Path) -> Result<Rig, RigFileError> {
 
 /// Parses and validates a rig from TOML `text`; `path` names it in errors.
 pub fn from_toml(text: &str, path: &Path) -> Result<Rig, RigFileError> {
-    let syntax = |e: toml::de::Error| RigFileError::Syntax {
-        file: path.to_path_buf(),
-        line: e
+    let syntax = |e: toml::de::Error| {
+        let line = e
             .span()
-            .map(|s| 1 + text[..s.start.min(text.len())].matches('\n').count()),
-        message: e.to_string().trim_end().to_string(),
+            .map(|s| 1 + text[..s.start.min(text.len())].matches('\n').count());
+        RigFileError::Syntax {
+            file: path.to_path_buf(),
+            key: line.and_then(|l| key_at_line(text, l)),
+            line,
+            message: e.to_string().trim_end().to_string(),
+        }
     };
     let rig: Rig = toml::from_str(text).map_err(syntax)?;
     // Keys serde skipped: everything in the file that the rig does not write back.
     let given: toml::Table = toml::from_str(text).map_err(syntax)?;
     let known = toml::Table::try_from(&rig).map_err(|e| RigFileError::Syntax {
         file: path.to_path_buf(),
+        key: None,
         line: None,
         message: e.to_string(),
     })?;
@@ -133,6 +141,28 @@ fn first_unknown_key(given: &toml::Table, known: &toml::Table, prefix: &str) -> 
     None
 }
 
+/// The dotted key assigned on 1-based `line`: the last table header above it and the key
+/// left of `=` (`None` when the line assigns nothing).
+fn key_at_line(text: &str, line: usize) -> Option<String> {
+    let mut table = String::new();
+    for l in text.lines().take(line.saturating_sub(1)) {
+        let l = l.trim();
+        if l.starts_with('[') {
+            table = l.trim_matches(|c| c == '[' || c == ']').trim().to_string();
+        }
+    }
+    let (k, _) = text.lines().nth(line.checked_sub(1)?)?.split_once('=')?;
+    let k = k.trim().trim_matches('"');
+    if k.is_empty() || k.starts_with('#') {
+        return None;
+    }
+    Some(if table.is_empty() {
+        k.to_string()
+    } else {
+        format!("{table}.{k}")
+    })
+}
+
 /// Best-effort line of a dotted key: the first line that assigns its last segment after the
 /// table header of its first segment (0 when not found; the key is named either way).
 fn line_of_key(text: &str, key: &str) -> usize {
@@ -189,7 +219,7 @@ mod tests {
         let e = from_toml(&text, p()).unwrap_err();
         let msg = e.to_string();
         assert!(msg.contains("my-rig.toml"), "{msg}");
-        assert!(msg.contains("precharge_pa"), "{msg}");
+        assert!(msg.contains("key `absorber.precharge_pa`"), "{msg}");
         let want = 1 + text[..text.find("\"three\"").unwrap()]
             .matches('\n')
             .count();

@@ -306,7 +306,7 @@ impl AccumulatorDesign {
     pub fn to_table(&self) -> String {
         let mpa = |p: f64| p / 1e6;
         let opt = |p: Option<f64>| {
-            p.map_or("none (absorber empty)".to_string(), |p| {
+            p.map_or("unreachable (needs precharge >= p_w)".to_string(), |p| {
                 format!("{:.3} MPa", mpa(p))
             })
         };
