@@ -319,6 +319,15 @@ const I: f64 = 3.85e5; // kg/m⁴
 const R: f64 = 3e7; // Pa·s/m³
 const P_ATM: f64 = 101_325.0;
 
+/// Natural frequency [Hz] and damping ratio of the absorber precharged to `precharge`
+/// at `pressure` (both gauge): gas volume V0·(p0/p)^(1/n), capacitance C = V/(n·p) in
+/// absolute pressure, ω_n = 1/√(I·C), ζ = (R/2)·√(C/I).
+fn hand_absorber(precharge: f64, pressure: f64) -> (f64, f64) {
+    let (p0, p) = (precharge + P_ATM, pressure + P_ATM);
+    let c = V0 * (p0 / p).powf(1.0 / N) / (N * p);
+    (1.0 / (I * c).sqrt() / (2.0 * PI), R / 2.0 * (c / I).sqrt())
+}
+
 fn design_json(extra: &[&str]) -> serde_json::Value {
     let mut args = vec!["accumulator-design", "--json", "-"];
     args.extend_from_slice(extra);
@@ -350,19 +359,10 @@ fn accumulator_design_matches_hand_computation() {
         1e-9
     ));
 
-    // Absorber precharged to 3 MPa, at 5 MPa: C = V0·(p0/p)^(1/n)/(n·p), absolute p.
-    let (p0, p) = (3e6 + P_ATM, 5e6 + P_ATM);
-    let c = V0 * (p0 / p).powf(1.0 / N) / (N * p);
-    assert!(close(
-        f(&v, "natural_frequency_hz"),
-        1.0 / (I * c).sqrt() / (2.0 * PI),
-        1e-9
-    ));
-    assert!(close(
-        f(&v, "damping_ratio"),
-        R / 2.0 * (c / I).sqrt(),
-        1e-9
-    ));
+    // Absorber precharged to 3 MPa, at 5 MPa.
+    let (f_n, zeta) = hand_absorber(3e6, 5e6);
+    assert!(close(f(&v, "natural_frequency_hz"), f_n, 1e-9));
+    assert!(close(f(&v, "damping_ratio"), zeta, 1e-9));
 
     // Eq. 31–32 at the precharge state: n·p/(I·V0) = ω_1² and R²·V0/(4·I·n·p) = 1/2.
     let w1 = 2.0 * PI * 16.8;
@@ -389,13 +389,9 @@ fn accumulator_design_follows_the_rig_file_and_the_pressure() {
     let file = dir.join("rig.toml");
     fs::write(&file, rig_file::to_toml(&rig)).unwrap();
     let v = design_json(&["--rig", s(&file), "--pressure", "8e6"]);
-    let (p0, p) = (4e6 + P_ATM, 8e6 + P_ATM);
-    let c = V0 * (p0 / p).powf(1.0 / N) / (N * p);
-    assert!(close(
-        f(&v, "natural_frequency_hz"),
-        1.0 / (I * c).sqrt() / (2.0 * PI),
-        1e-9
-    ));
+    let (f_n, zeta) = hand_absorber(4e6, 8e6);
+    assert!(close(f(&v, "natural_frequency_hz"), f_n, 1e-9));
+    assert!(close(f(&v, "damping_ratio"), zeta, 1e-9));
     // Leakage 1e-13·(7.5e6 + 8e6 + 7.5e6) = 2.3e-6 m³/s → 2.3/1.5 rev/s × 18.
     assert!(close(
         f(&v, "pulsation_frequency_hz"),
