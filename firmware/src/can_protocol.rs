@@ -59,8 +59,15 @@
 //!
 //! Reason codes: `1` value below the minimum, `2` value above the maximum, `3` wrong data
 //! length (bound = expected DLC), `4` unknown mode code (bound = highest mode code), `5`
-//! refused in the present state (for example a fault is latched), `6` unknown function
+//! refused in the present state (bound = the code of the latched or present fault that
+//! blocks it, `0` for a mode change that must go through disabled), `6` unknown function
 //! (bound = `0`), `7` value not acceptable for another reason.
+
+use crate::controller::{Command, CommandError};
+use crate::supervisor::{Mode, ModeRefusal};
+
+/// Highest mode code on the wire (the codes are the control core's [`Mode::code`]).
+pub const MODE_CODE_MAX: u8 = 3;
 
 /// Highest node number (the node occupies the identifier's low 4 bits).
 pub const NODE_MAX: u8 = 15;
@@ -163,45 +170,6 @@ impl NodeId {
     }
 }
 
-/// Operating mode as coded on the wire.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum WireMode {
-    /// PWM off. Code 0.
-    Disabled,
-    /// Current-offset calibration and encoder alignment. Code 1.
-    Calibrating,
-    /// Speed control. Code 2.
-    Speed,
-    /// Pressure control. Code 3.
-    Pressure,
-}
-
-impl WireMode {
-    /// Highest valid mode code.
-    pub const MAX_CODE: u8 = 3;
-
-    /// The wire code.
-    pub fn code(self) -> u8 {
-        match self {
-            WireMode::Disabled => 0,
-            WireMode::Calibrating => 1,
-            WireMode::Speed => 2,
-            WireMode::Pressure => 3,
-        }
-    }
-
-    /// Parses a wire code.
-    pub fn from_code(code: u8) -> Option<WireMode> {
-        match code {
-            0 => Some(WireMode::Disabled),
-            1 => Some(WireMode::Calibrating),
-            2 => Some(WireMode::Speed),
-            3 => Some(WireMode::Pressure),
-            _ => None,
-        }
-    }
-}
-
 /// Which command a frame carries; its code is the identifier base shifted right by 4.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Function {
@@ -266,7 +234,7 @@ impl Function {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Request {
     /// Switch the operating mode.
-    SetMode(WireMode),
+    SetMode(Mode),
     /// Pressure setpoint, gauge. [Pa]
     SetPressure {
         /// Setpoint. [Pa]
@@ -317,6 +285,21 @@ impl Request {
         }
     }
 
+    /// The control core's command for this request (setpoints converted to SI units).
+    pub fn to_command(&self) -> Command {
+        match *self {
+            Request::SetMode(mode) => Command::SetMode(mode),
+            Request::SetPressure { pa } => Command::SetPressure {
+                pa: pa as f32 * SETPOINT_PA_PER_LSB,
+            },
+            Request::SetSpeed { mrad_s } => Command::SetSpeed {
+                rad_s: mrad_s as f32 * SETPOINT_RAD_S_PER_LSB,
+            },
+            Request::ClearFaults => Command::ClearFaults,
+            Request::Heartbeat => Command::Heartbeat,
+        }
+    }
+
     /// Speed setpoint in SI units, if this is one. [rad/s]
     pub fn speed_rad_s(&self) -> Option<f32> {
         match self {
@@ -337,7 +320,8 @@ pub enum RejectReason {
     WrongLength,
     /// Unknown mode code (the bound is the highest mode code). Code 4.
     UnknownMode,
-    /// Not allowed in the present state, e.g. a fault is latched. Code 5.
+    /// Not allowed in the present state (the bound is the blocking fault's code, 0 for a
+    /// mode transition that must go through Disabled). Code 5.
     NotAllowed,
     /// Unknown function in a command identifier. Code 6.
     UnknownFunction,
@@ -377,7 +361,7 @@ impl RejectReason {
 /// Periodic drive status, in wire units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Status {
-    /// Operating mode code (see [`WireMode`]).
+    /// Operating mode code (see [`Mode`]).
     pub mode: u8,
     /// Controller fault code, `0` for none.
     pub fault: u8,
@@ -394,7 +378,7 @@ pub struct Status {
 impl Status {
     /// Builds a status from SI measurements, saturating them to the wire fields.
     pub fn from_si(
-        mode: WireMode,
+        mode: Mode,
         fault: u8,
         pressure_pa: f32,
         speed_rad_s: f32,
@@ -425,6 +409,45 @@ pub struct Rejection {
 }
 
 impl Rejection {
+    /// The reply for a well-formed request the controller refused, naming the violated
+    /// bound in the request's wire unit (rounded to the nearest wire LSB).
+    pub fn for_command_error(request: &Request, err: &CommandError) -> Rejection {
+        let function = request.function().code();
+        let (reason, bound) = match *err {
+            CommandError::PressureOutOfRange { min_pa, max_pa } => match request {
+                Request::SetPressure { pa } if (*pa as f32) < min_pa => (
+                    RejectReason::BelowMinimum,
+                    wire_bound(min_pa, SETPOINT_PA_PER_LSB),
+                ),
+                Request::SetPressure { .. } => (
+                    RejectReason::AboveMaximum,
+                    wire_bound(max_pa, SETPOINT_PA_PER_LSB),
+                ),
+                _ => (RejectReason::Invalid, 0),
+            },
+            CommandError::SpeedOutOfRange { max_rad_s } => match request {
+                Request::SetSpeed { mrad_s } if *mrad_s < 0 => (
+                    RejectReason::BelowMinimum,
+                    wire_bound(-max_rad_s, SETPOINT_RAD_S_PER_LSB),
+                ),
+                Request::SetSpeed { .. } => (
+                    RejectReason::AboveMaximum,
+                    wire_bound(max_rad_s, SETPOINT_RAD_S_PER_LSB),
+                ),
+                _ => (RejectReason::Invalid, 0),
+            },
+            CommandError::Mode(ModeRefusal::Faulted(f))
+            | CommandError::Mode(ModeRefusal::ConditionPresent(f))
+            | CommandError::CausePresent(f) => (RejectReason::NotAllowed, i32::from(f.code())),
+            CommandError::Mode(ModeRefusal::Transition { .. }) => (RejectReason::NotAllowed, 0),
+        };
+        Rejection {
+            function,
+            reason,
+            bound,
+        }
+    }
+
     /// The reply the drive sends for a command frame that failed to decode, or `None` when
     /// the frame is to be ignored silently (addressed to another node, or not a command).
     pub fn for_decode_error(err: &DecodeError) -> Option<Rejection> {
@@ -439,7 +462,7 @@ impl Rejection {
             DecodeError::UnknownMode { .. } => Some(Rejection {
                 function: Function::SetMode.code(),
                 reason: RejectReason::UnknownMode,
-                bound: i32::from(WireMode::MAX_CODE),
+                bound: i32::from(MODE_CODE_MAX),
             }),
             DecodeError::UnknownFunction { id } => Some(Rejection {
                 // An 11-bit identifier shifted by 4 fits a byte.
@@ -504,7 +527,7 @@ pub enum DecodeError {
         /// Received data length. [bytes]
         got: u8,
     },
-    /// A `SetMode` frame with a mode code above [`WireMode::MAX_CODE`].
+    /// A `SetMode` frame with a mode code above [`MODE_CODE_MAX`].
     UnknownMode {
         /// The received code.
         code: u8,
@@ -548,7 +571,7 @@ pub fn decode_command(frame: &Frame, node: NodeId) -> Result<Request, DecodeErro
     match function {
         Function::SetMode => {
             let code = payload.first().copied().unwrap_or(u8::MAX);
-            WireMode::from_code(code)
+            Mode::from_code(code)
                 .map(Request::SetMode)
                 .ok_or(DecodeError::UnknownMode { code })
         }
@@ -656,6 +679,11 @@ fn write_i32(data: &mut [u8; MAX_DLC], at: usize, value: i32) {
     }
 }
 
+fn wire_bound(si: f32, per_lsb: f32) -> i32 {
+    // `as` saturates (and maps NaN to 0), so a bound beyond the field is sent as its limit.
+    libm::roundf(si / per_lsb) as i32
+}
+
 fn saturate_i16(x: f32) -> i16 {
     // `as` saturates and maps NaN to 0, which is the wanted behaviour for a status field.
     libm::roundf(x) as i16
@@ -683,6 +711,7 @@ fn to_wire(value: f32, per_lsb: f32, field: &'static str) -> Result<i32, EncodeE
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::supervisor::FaultCode;
 
     fn node(n: u8) -> NodeId {
         NodeId::new(n).expect("valid node")
@@ -697,7 +726,7 @@ mod tests {
         let f = encode_command(&Request::SetSpeed { mrad_s: -1500 }, node(0));
         assert_eq!(f.id(), 0x120);
         assert_eq!(f.payload(), &[0x24, 0xFA, 0xFF, 0xFF]);
-        let f = encode_command(&Request::SetMode(WireMode::Pressure), node(15));
+        let f = encode_command(&Request::SetMode(Mode::Pressure), node(15));
         assert_eq!((f.id(), f.payload()), (0x10F, &[3u8][..]));
         assert_eq!(encode_command(&Request::ClearFaults, node(1)).id(), 0x131);
         assert_eq!(
@@ -709,10 +738,10 @@ mod tests {
     #[test]
     fn every_command_round_trips() {
         let requests = [
-            Request::SetMode(WireMode::Disabled),
-            Request::SetMode(WireMode::Calibrating),
-            Request::SetMode(WireMode::Speed),
-            Request::SetMode(WireMode::Pressure),
+            Request::SetMode(Mode::Disabled),
+            Request::SetMode(Mode::Calibrating),
+            Request::SetMode(Mode::Speed),
+            Request::SetMode(Mode::Pressure),
             Request::SetPressure { pa: 0 },
             Request::SetPressure { pa: i32::MIN },
             Request::SetPressure { pa: i32::MAX },
@@ -828,7 +857,7 @@ mod tests {
     fn status_layout_and_round_trip() {
         // 5.2 MPa -> 5200 kPa = 0x1450; -31.4 rad/s -> -314 = 0xFEC6.
         let s = Status::from_si(
-            WireMode::Pressure,
+            Mode::Pressure,
             4,
             5.2e6,
             -31.4,
@@ -843,9 +872,9 @@ mod tests {
 
     #[test]
     fn status_fields_saturate() {
-        let s = Status::from_si(WireMode::Speed, 0, 1.0e9, f32::NAN, NO_COMMAND, 0);
+        let s = Status::from_si(Mode::Speed, 0, 1.0e9, f32::NAN, NO_COMMAND, 0);
         assert_eq!((s.pressure_kpa, s.speed_drad_s), (i16::MAX, 0));
-        let s = Status::from_si(WireMode::Speed, 0, -1.0e9, -1.0e6, NO_COMMAND, 0);
+        let s = Status::from_si(Mode::Speed, 0, -1.0e9, -1.0e6, NO_COMMAND, 0);
         assert_eq!((s.pressure_kpa, s.speed_drad_s), (i16::MIN, i16::MIN));
     }
 
@@ -895,6 +924,69 @@ mod tests {
         assert_eq!(
             decode_reply(&Frame::new(0x111, &[0; 4]).unwrap(), me),
             Err(DecodeError::UnknownFunction { id: 0x111 })
+        );
+    }
+
+    #[test]
+    fn requests_map_to_core_commands_in_si_units() {
+        assert_eq!(
+            Request::SetPressure { pa: 4_500_000 }.to_command(),
+            Command::SetPressure { pa: 4.5e6 }
+        );
+        assert_eq!(
+            Request::SetSpeed { mrad_s: -2_500 }.to_command(),
+            Command::SetSpeed { rad_s: -2.5 }
+        );
+        assert_eq!(
+            Request::SetMode(Mode::Speed).to_command(),
+            Command::SetMode(Mode::Speed)
+        );
+        assert_eq!(Request::Heartbeat.to_command(), Command::Heartbeat);
+        assert_eq!(Request::ClearFaults.to_command(), Command::ClearFaults);
+    }
+
+    #[test]
+    fn refusals_name_the_violated_bound() {
+        let range = CommandError::PressureOutOfRange {
+            min_pa: 0.0,
+            max_pa: 18e6,
+        };
+        let r = Rejection::for_command_error(&Request::SetPressure { pa: 20_000_000 }, &range);
+        assert_eq!(
+            r,
+            Rejection {
+                function: 0x11,
+                reason: RejectReason::AboveMaximum,
+                bound: 18_000_000
+            }
+        );
+        let r = Rejection::for_command_error(&Request::SetPressure { pa: -5 }, &range);
+        assert_eq!((r.reason, r.bound), (RejectReason::BelowMinimum, 0));
+
+        let speed = CommandError::SpeedOutOfRange { max_rad_s: 200.0 };
+        let r = Rejection::for_command_error(&Request::SetSpeed { mrad_s: -250_000 }, &speed);
+        assert_eq!(
+            (r.function, r.reason, r.bound),
+            (0x12, RejectReason::BelowMinimum, -200_000)
+        );
+        let r = Rejection::for_command_error(&Request::SetSpeed { mrad_s: 250_000 }, &speed);
+        assert_eq!((r.reason, r.bound), (RejectReason::AboveMaximum, 200_000));
+
+        // Over-pressure is fault code 4 in the supervisor's table.
+        let blocked = CommandError::CausePresent(FaultCode::OverPressure);
+        let r = Rejection::for_command_error(&Request::ClearFaults, &blocked);
+        assert_eq!(
+            (r.function, r.reason, r.bound),
+            (0x13, RejectReason::NotAllowed, 4)
+        );
+        let transition = CommandError::Mode(ModeRefusal::Transition {
+            from: Mode::Speed,
+            to: Mode::Calibrating,
+        });
+        let r = Rejection::for_command_error(&Request::SetMode(Mode::Calibrating), &transition);
+        assert_eq!(
+            (r.function, r.reason, r.bound),
+            (0x10, RejectReason::NotAllowed, 0)
         );
     }
 

@@ -1,0 +1,113 @@
+//! The current-loop interrupt and the state it shares with the tasks.
+//!
+//! One ADC end-of-sequence interrupt per PWM period, at the highest priority: sample →
+//! [`Controller::on_current_sample`] (current loop every call; speed and pressure loops at
+//! their divided rates inside the façade) → duties to the bridge. The controller, the
+//! bridge and the sensors live in one critical-section mutex: the interrupt borrows them
+//! for its whole body, the tasks only for a command or a telemetry copy (microseconds), so
+//! the interrupt's jitter is bounded by the longest of those.
+//!
+//! Overrun: if ADC1 has already finished the next period's sequence when the body ends,
+//! the loop missed a sample; the controller latches its watchdog fault and the bridge is
+//! turned off at once. Liveness for the independent watchdog is the interrupt counter
+//! [`isr_count`], read by the supervision task.
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use cortex_m::peripheral::DWT;
+use embassy_sync::blocking_mutex::CriticalSectionMutex;
+use firmware::{Command, Controller, Mode};
+
+use super::board::CURRENT_ADC_REGS;
+use super::bridge::{Bridge, BridgeEvent};
+use super::sensors::Sensors;
+
+/// What the control interrupt owns.
+pub struct Drive {
+    /// The control core.
+    pub controller: Controller,
+    bridge: Bridge,
+    sensors: Sensors,
+}
+
+static DRIVE: CriticalSectionMutex<RefCell<Option<Drive>>> =
+    CriticalSectionMutex::new(RefCell::new(None));
+static ISR_COUNT: AtomicU32 = AtomicU32::new(0);
+static ISR_MAX_CYCLES: AtomicU32 = AtomicU32::new(0);
+static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+static BREAKS: AtomicU32 = AtomicU32::new(0);
+
+/// Installs the drive; the interrupt does nothing before this.
+pub fn install(controller: Controller, bridge: Bridge, sensors: Sensors) {
+    DRIVE.lock(|d| {
+        d.replace(Some(Drive {
+            controller,
+            bridge,
+            sensors,
+        }))
+    });
+}
+
+/// Runs `f` on the controller inside a critical section (keep `f` short: the current
+/// loop waits for it). `None` before [`install`].
+pub fn with_controller<R>(f: impl FnOnce(&mut Controller) -> R) -> Option<R> {
+    DRIVE.lock(|d| {
+        d.try_borrow_mut()
+            .ok()
+            .and_then(|mut d| d.as_mut().map(|d| f(&mut d.controller)))
+    })
+}
+
+/// Number of completed control interrupts (wraps).
+pub fn isr_count() -> u32 {
+    ISR_COUNT.load(Ordering::Relaxed)
+}
+
+/// Longest control-interrupt body so far. [CPU cycles]
+pub fn isr_max_cycles() -> u32 {
+    ISR_MAX_CYCLES.load(Ordering::Relaxed)
+}
+
+/// Overruns seen so far.
+pub fn overruns() -> u32 {
+    OVERRUNS.load(Ordering::Relaxed)
+}
+
+/// Hardware breaks seen so far.
+pub fn breaks() -> u32 {
+    BREAKS.load(Ordering::Relaxed)
+}
+
+/// The interrupt body (called from the vector in the board module).
+pub fn on_current_sample_interrupt() {
+    let start = DWT::cycle_count();
+    DRIVE.lock(|d| {
+        if let Ok(mut d) = d.try_borrow_mut() {
+            if let Some(d) = d.as_mut() {
+                d.step();
+            }
+        }
+    });
+    let cycles = DWT::cycle_count().wrapping_sub(start);
+    ISR_MAX_CYCLES.fetch_max(cycles, Ordering::Relaxed);
+    ISR_COUNT.fetch_add(1, Ordering::Relaxed);
+}
+
+impl Drive {
+    fn step(&mut self) {
+        let m = self.sensors.sample();
+        let out = self.controller.on_current_sample(&m);
+        if self.bridge.apply(&out) == BridgeEvent::Break {
+            // The hardware has already cut the bridge; bring the controller to the same
+            // state so that restarting takes a command.
+            BREAKS.fetch_add(1, Ordering::Relaxed);
+            let _ = self.controller.command(Command::SetMode(Mode::Disabled));
+        }
+        if CURRENT_ADC_REGS.isr().read().jeos() {
+            OVERRUNS.fetch_add(1, Ordering::Relaxed);
+            self.controller.report_overrun();
+            self.bridge.disable();
+        }
+    }
+}

@@ -1,0 +1,48 @@
+//! The sensor read-out of one PWM period: injected ADC results (phase currents, DC link,
+//! pressure) and the encoder counter with its index capture, as the control core's
+//! [`Measurements`].
+//!
+//! Both ADCs convert at the same TIM1 trigger (the counter peak). The control interrupt
+//! fires at the end of ADC1's short sequence (about 2 µs); ADC2's 16-fold oversampled
+//! pressure conversion takes about 14 µs, so its data register still holds the result of
+//! the previous period — a 50 µs delay, negligible for the 1 kHz pressure loop. (At PWM
+//! rates above about 60 kHz the pressure conversion outlasts the period and only every
+//! other trigger is converted; the value is then two periods old.)
+
+use super::board::{SensorPeripherals, ENCODER_INDEX_CHANNEL, ENCODER_REGS};
+use firmware::Measurements;
+
+/// The sensor driver.
+pub struct Sensors {
+    peripherals: SensorPeripherals,
+}
+
+impl Sensors {
+    /// Takes over the sensor peripherals.
+    pub fn new(peripherals: SensorPeripherals) -> Sensors {
+        Sensors { peripherals }
+    }
+
+    /// Reads this period's samples. Reading ADC1's injected results also clears its
+    /// end-of-sequence flag, which acknowledges the interrupt.
+    pub fn sample(&mut self) -> Measurements {
+        let [ia, ib, ic, udc] = self.peripherals.currents.read_injected_samples();
+        let [pressure] = self.peripherals.pressure.read_injected_samples();
+        let encoder_count = ENCODER_REGS.cnt().read();
+        let encoder_index = ENCODER_REGS.sr().read().ccif(ENCODER_INDEX_CHANNEL);
+        if encoder_index {
+            // Cleared by writing 0; TIM2 has no other flag in use, so read-modify-write
+            // cannot lose one.
+            ENCODER_REGS
+                .sr()
+                .modify(|w| w.set_ccif(ENCODER_INDEX_CHANNEL, false));
+        }
+        Measurements {
+            adc_phase_current: [ia, ib, ic],
+            adc_dc_link: udc,
+            adc_pressure: pressure,
+            encoder_count,
+            encoder_index,
+        }
+    }
+}
