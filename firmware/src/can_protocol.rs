@@ -991,6 +991,27 @@ mod tests {
     }
 
     #[test]
+    fn mode_codes_are_the_four_documented_ones() {
+        // 0 disabled, 1 calibrating, 2 speed, 3 pressure (module documentation).
+        let documented = [
+            Mode::Disabled,
+            Mode::Calibrating,
+            Mode::Speed,
+            Mode::Pressure,
+        ];
+        for (code, mode) in documented.into_iter().enumerate() {
+            let f = encode_command(&Request::SetMode(mode), node(0));
+            assert_eq!(f.payload(), &[code as u8]);
+        }
+        assert_eq!(usize::from(MODE_CODE_MAX) + 1, documented.len());
+        let f = Frame::new(0x100, &[MODE_CODE_MAX + 1]).unwrap();
+        assert!(matches!(
+            decode_command(&f, node(0)),
+            Err(DecodeError::UnknownMode { .. })
+        ));
+    }
+
+    #[test]
     fn function_codes_are_the_identifier_base_shifted() {
         for f in [
             Function::SetMode,
