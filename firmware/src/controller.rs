@@ -338,9 +338,13 @@ impl Controller {
         // Fault conditions of this sample.
         let l = &self.cfg.limits;
         let s = &self.cfg.sensors;
-        let i_max = self.state.i_abc.iter().fold(0.0f32, |a, i| a.max(i.abs()));
-        // NaN currents count as over-current.
-        let over_current = i_max.is_nan() || i_max > l.over_current_a;
+        // A NaN current counts as over-current (a fold with f32::max would drop the NaN, and
+        // costs an fmaxf call per phase on the M4F).
+        let over_current = self
+            .state
+            .i_abc
+            .iter()
+            .any(|i| i.is_nan() || i.abs() > l.over_current_a);
         conditions.set(FaultCode::PhaseOverCurrent, over_current);
         conditions.set(
             FaultCode::DcLinkOverVoltage,

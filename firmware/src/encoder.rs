@@ -8,6 +8,8 @@
 //! turns less than half a revolution per current-loop period, which the configuration
 //! enforces with margin.
 
+use core::num::NonZeroU32;
+
 /// What one encoder sample revealed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EncoderEvent {
@@ -23,7 +25,9 @@ pub enum EncoderEvent {
 /// Encoder decoder state.
 #[derive(Clone, Copy, Debug)]
 pub struct Encoder {
-    counts_per_rev: u32,
+    /// Non-zero by type, so `count % counts_per_rev` has no division-by-zero panic path in
+    /// the ISR.
+    counts_per_rev: NonZeroU32,
     half: i32,
     rad_per_count: f32,
     elec_rad_per_count: f32,
@@ -41,11 +45,12 @@ impl Encoder {
     /// For `counts_per_rev` counts, `pole_pairs`, the electrical offset `offset_rad` [rad]
     /// and the largest plausible step `max_step` [counts per sample].
     pub fn new(counts_per_rev: u32, pole_pairs: u32, offset_rad: f32, max_step: u32) -> Encoder {
-        let n = counts_per_rev.max(4);
+        // The wrapped difference below works in i32.
+        let n = counts_per_rev.clamp(4, 1 << 24);
         let rad_per_count = core::f32::consts::TAU / n as f32;
         let max_step = (max_step.min(n / 4)) as i32;
         Encoder {
-            counts_per_rev: n,
+            counts_per_rev: NonZeroU32::new(n).unwrap_or(NonZeroU32::MIN),
             half: (n / 2) as i32,
             rad_per_count,
             elec_rad_per_count: rad_per_count * pole_pairs as f32,
@@ -107,7 +112,7 @@ impl Encoder {
             self.last_count = count;
             return EncoderEvent::Ok;
         }
-        let n = self.counts_per_rev as i32;
+        let n = self.counts_per_rev.get() as i32;
         let mut delta = count as i32 - self.last_count as i32;
         if delta >= self.half {
             delta -= n;

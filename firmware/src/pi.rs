@@ -21,6 +21,21 @@
 //! clamped to the output range so it can never wind beyond it. Kb·T is capped at 1
 //! (dead-beat tracking), the stability bound of the discrete tracking loop.
 
+/// `x` limited to `[lo, hi]` by two comparisons: unlike `f32::clamp` it has no panic path
+/// (clamp asserts `lo <= hi`), and unlike `f32::max`/`min` it needs no `fmaxf`/`fminf` call
+/// on a Cortex-M4F (no `vmaxnm` in FPv4), so the current-loop step stays branch-light.
+/// A NaN `x` passes through unchanged; callers that care check finiteness first.
+#[inline(always)]
+pub fn saturate(x: f32, lo: f32, hi: f32) -> f32 {
+    if x > hi {
+        hi
+    } else if x < lo {
+        lo
+    } else {
+        x
+    }
+}
+
 /// PI state and discretised gains.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pi {
@@ -73,7 +88,7 @@ impl Pi {
     /// the proportional term at the last error.
     pub fn set_gains(&mut self, kp: f32, ki: f32) {
         let bump = (self.kp - kp) * self.last_error;
-        self.integral = (self.integral + bump).clamp(self.min, self.max);
+        self.integral = saturate(self.integral + bump, self.min, self.max);
         self.set_gains_raw(kp, ki);
     }
 
@@ -81,13 +96,13 @@ impl Pi {
     pub fn set_limits(&mut self, min: f32, max: f32) {
         self.min = min.min(max);
         self.max = max.max(min);
-        self.integral = self.integral.clamp(self.min, self.max);
+        self.integral = saturate(self.integral, self.min, self.max);
     }
 
     /// Sets the integral state (in output units) and forgets the last error: start a loop
     /// at `value` without a bump.
     pub fn reset(&mut self, value: f32) {
-        self.integral = value.clamp(self.min, self.max);
+        self.integral = saturate(value, self.min, self.max);
         self.last_error = 0.0;
     }
 
@@ -107,11 +122,14 @@ impl Pi {
     pub fn step(&mut self, error: f32, ff: f32) -> f32 {
         let u = self.kp * error + self.integral + ff;
         if !u.is_finite() {
-            return self.integral.clamp(self.min, self.max);
+            return saturate(self.integral, self.min, self.max);
         }
-        let y = u.clamp(self.min, self.max);
-        self.integral =
-            (self.integral + self.ki_t * error + self.kb_t * (y - u)).clamp(self.min, self.max);
+        let y = saturate(u, self.min, self.max);
+        self.integral = saturate(
+            self.integral + self.ki_t * error + self.kb_t * (y - u),
+            self.min,
+            self.max,
+        );
         self.last_error = error;
         y
     }

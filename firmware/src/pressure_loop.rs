@@ -55,7 +55,7 @@
 //! ramped at `ramp_pa_per_s` toward the commanded value.
 
 use crate::config::{Config, Hydraulics};
-use crate::pi::Pi;
+use crate::pi::{saturate, Pi};
 
 /// Damping ratio promised for every closed-loop pole except the absorber resonance. [1]
 pub const PROMISED_DAMPING: f64 = 0.8;
@@ -172,7 +172,7 @@ impl PressureLoop {
             self.filtered += self.filter_alpha * (p_meas - self.filtered);
         }
         let prev = self.ramped;
-        let d = (self.target - self.ramped).clamp(-self.ramp_step, self.ramp_step);
+        let d = saturate(self.target - self.ramped, -self.ramp_step, self.ramp_step);
         self.ramped += d;
         let ramp_rate = if self.ramped != prev {
             if d > 0.0 {

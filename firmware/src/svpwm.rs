@@ -37,8 +37,10 @@ pub fn modulate(v: AlphaBeta, u_dc: f32) -> Modulation {
         };
     }
     let [a, b, c] = inverse_clarke(v);
-    let max = a.max(b).max(c);
-    let min = a.min(b).min(c);
+    // Comparisons rather than f32::max/min: those become fmaxf/fminf calls on the M4F.
+    let (hi_ab, lo_ab) = if a > b { (a, b) } else { (b, a) };
+    let max = if c > hi_ab { c } else { hi_ab };
+    let min = if c < lo_ab { c } else { lo_ab };
     let span = max - min;
     let (scale, limited) = if span > u_dc {
         (u_dc / span, true)
