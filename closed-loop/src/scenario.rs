@@ -69,7 +69,9 @@ pub const SCENARIOS: [Scenario; 4] = [
         kind: ScenarioKind::PressureStep,
         blocked: true,
         initial_pressure_pa: 3e6,
-        duration_s: 2.0,
+        // Long enough for the speed-limited fill of a low-precharge absorber (≈ 2.3 s at
+        // 2 MPa: ~130 pump revolutions at the 200 rad/s limit).
+        duration_s: 4.0,
         steady_from_s: 0.5,
         events: [
             Some((0.0, Command::SetPressure { pa: 3e6 })),

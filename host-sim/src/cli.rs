@@ -97,6 +97,9 @@ pub struct SimulateArgs {
     /// Name the scenarios and exit.
     #[arg(long)]
     pub list: bool,
+    /// Write a run summary as JSON, with the real-time factor (`-`: standard output).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
 }
 
 /// `eha sweep-precharge`.

@@ -1,0 +1,145 @@
+//! One closed-loop run turned into a bench log: the firmware's control core against the
+//! plant through `closed_loop`, logged like the firmware's telemetry (the controller's
+//! measured and commanded quantities) plus the plant-side columns a rig's extra sensors
+//! would give (piston position, low-side pressure), and the true port pressure kept aside
+//! for the pulsation study.
+
+use crate::bench_log::BenchLog;
+use closed_loop::{controller_config, ClosedLoop, Scenario};
+use indicatif::{ProgressBar, ProgressStyle};
+use plant_model::Rig;
+use std::time::{Duration, Instant};
+
+/// What a run produced.
+pub struct Run {
+    /// The bench log (every column the simulation knows).
+    pub log: BenchLog,
+    /// True port-A pressure at the log's instants. [Pa]
+    pub p_true_pa: Vec<f64>,
+    /// True shaft speed at the log's instants. [rad/s]
+    pub speed_true_rad_s: Vec<f64>,
+    /// The absorber's natural frequency and damping ratio at the run's mean pressure
+    /// (0 when the absorber holds no oil). [Hz], [1]
+    pub absorber_fn_hz: f64,
+    /// See `absorber_fn_hz`.
+    pub absorber_zeta: f64,
+    /// Simulated seconds per wall-clock second.
+    pub real_time_factor: f64,
+}
+
+/// Options of a run.
+pub struct RunOptions {
+    /// Simulated length. [s]
+    pub duration_s: f64,
+    /// Log rate (the firmware's telemetry decimation gives 1 kHz at 20 kHz PWM). [Hz]
+    pub log_rate_hz: f64,
+    /// Sensor-noise seed.
+    pub seed: u64,
+    /// Show a progress bar when the run is expected to take over a second.
+    pub progress: bool,
+    /// Metadata lines for the log.
+    pub metadata: Vec<(String, String)>,
+}
+
+/// Runs `scenario` on the plant `plant_rig`, controlled by the configuration of
+/// `controller_rig` (the rig file the engineer believes in).
+pub fn run(
+    plant_rig: &Rig,
+    controller_rig: &Rig,
+    scenario: &Scenario,
+    opt: &RunOptions,
+) -> Result<Run, String> {
+    let config = controller_config(controller_rig);
+    let mut cl =
+        ClosedLoop::new(plant_rig, &config, scenario, opt.seed).map_err(|e| e.to_string())?;
+    let every = ((1.0 / opt.log_rate_hz) / cl.period_s()).round().max(1.0) as u32;
+    let n_rows = (opt.duration_s / (cl.period_s() * every as f64)).ceil() as usize;
+    let mut log = BenchLog {
+        metadata: opt.metadata.clone(),
+        ..BenchLog::default()
+    };
+    let mut cols: [Vec<f64>; 8] = Default::default();
+    let mut p_true = Vec::with_capacity(n_rows);
+    let mut w_true = Vec::with_capacity(n_rows);
+    let bar = if opt.progress && opt.duration_s > 20.0 {
+        let b = ProgressBar::new(n_rows as u64);
+        b.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b.set_message(scenario.name);
+        b.enable_steady_tick(Duration::from_millis(200));
+        Some(b)
+    } else {
+        None
+    };
+    let started = Instant::now();
+    let mut k = 0u64;
+    cl.run(opt.duration_s, every, |s| {
+        let t = &s.telemetry;
+        log.t_s.push(s.truth.t_s);
+        log.p_ref_pa.push(t.p_ref_pa as f64);
+        log.p_pa.push(t.p_pa as f64);
+        log.speed_rad_s.push(t.speed_rad_s as f64);
+        log.iq_a.push(t.iq_a as f64);
+        log.id_a.push(t.id_a as f64);
+        for (c, v) in cols.iter_mut().zip([
+            t.theta_m_rad as f64,
+            s.truth.x_m,
+            s.truth.p_b_pa,
+            t.speed_ref_rad_s as f64,
+            t.iq_ref_a as f64,
+            t.ud_v as f64,
+            t.uq_v as f64,
+            t.udc_v as f64,
+        ]) {
+            c.push(v);
+        }
+        p_true.push(s.truth.p_a_pa);
+        w_true.push(s.truth.omega_m_rad_s);
+        k += 1;
+        if let Some(b) = &bar {
+            if k % 256 == 0 {
+                b.set_position(k);
+            }
+        }
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let wall = started.elapsed().as_secs_f64();
+    let [theta, x, p_low, w_ref, iq_ref, ud, uq, udc] = cols;
+    log.theta_m_rad = Some(theta);
+    log.x_m = Some(x);
+    log.p_low_pa = Some(p_low);
+    log.speed_ref_rad_s = Some(w_ref);
+    log.iq_ref_a = Some(iq_ref);
+    log.ud_v = Some(ud);
+    log.uq_v = Some(uq);
+    log.udc_v = Some(udc);
+    let steady: Vec<f64> = log
+        .t_s
+        .iter()
+        .zip(&p_true)
+        .filter(|(t, _)| **t >= scenario.steady_from_s.min(opt.duration_s / 2.0))
+        .map(|(_, p)| *p)
+        .collect();
+    let mean = steady.iter().sum::<f64>() / steady.len().max(1) as f64;
+    let absorber = cl.plant().absorber();
+    let (fn_hz, zeta) = if absorber.enabled {
+        (
+            absorber.natural_frequency_rad_s(mean) / (2.0 * std::f64::consts::PI),
+            absorber.damping_ratio(mean),
+        )
+    } else {
+        (0.0, 0.0)
+    };
+    Ok(Run {
+        log,
+        p_true_pa: p_true,
+        speed_true_rad_s: w_true,
+        absorber_fn_hz: fn_hz,
+        absorber_zeta: zeta,
+        real_time_factor: opt.duration_s / wall.max(1e-9),
+    })
+}
