@@ -22,6 +22,7 @@ pub mod pi;
 pub mod pressure_loop;
 pub mod scaling;
 pub mod speed_loop;
+pub mod speed_observer;
 pub mod supervisor;
 pub mod svpwm;
 pub mod telemetry;
