@@ -2,7 +2,7 @@
 //! the current loop, the speed and pressure loops at their divided rates, the calibration
 //! sequence and the supervisor checks; [`Controller::command`] takes the commands.
 //!
-//! Order inside one call: encoder decode → pressure loop (on its tick) → speed loop (on its
+//! Order inside one call: encoder decode and speed observer → pressure loop (on its tick) → speed loop (on its
 //! tick) → current loop → fault conditions → supervisor. A fault found in a call returns
 //! disabled PWM from that same call.
 //!
@@ -22,6 +22,7 @@ use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
 use crate::io::{Measurements, Outputs};
 use crate::pressure_loop::PressureLoop;
 use crate::speed_loop::SpeedLoop;
+use crate::speed_observer::SpeedObserver;
 use crate::supervisor::{Conditions, FaultCode, Mode, ModeRefusal, Supervisor};
 use crate::telemetry::TelemetryFrame;
 use crate::transforms::{wrap_2pi, Dq};
@@ -135,6 +136,7 @@ pub struct Controller {
     d: Derived,
     current: CurrentLoop,
     speed: SpeedLoop,
+    observer: SpeedObserver,
     pressure: PressureLoop,
     encoder: Encoder,
     sup: Supervisor,
@@ -182,6 +184,11 @@ impl Controller {
             },
             current: CurrentLoop::new(config),
             speed: SpeedLoop::new(config),
+            observer: SpeedObserver::new(
+                config.speed.observer_bandwidth_rad_s,
+                pwm,
+                config.sensors.encoder_counts_per_rev,
+            ),
             pressure: PressureLoop::new(config),
             encoder: Encoder::new(
                 config.sensors.encoder_counts_per_rev,
@@ -265,6 +272,14 @@ impl Controller {
         self.samples = self.samples.wrapping_add(1);
         self.since_command = self.since_command.saturating_add(1);
         let enc_event = self.encoder.update(m.encoder_count, m.encoder_index);
+        // An implausible jump is not a shaft movement: the observer coasts over it, so a
+        // one-sample glitch does not leave a speed transient behind after it latched its
+        // fault.
+        if enc_event == EncoderEvent::Jump {
+            self.observer.coast();
+        } else {
+            self.observer.update(self.encoder.position());
+        }
         self.theta_m = self.encoder.mechanical_angle(m.encoder_count);
         let mut theta_e = self.encoder.electrical_angle(m.encoder_count);
         self.p_pa = self.pressure_pa(m.adc_pressure as f32);
@@ -294,7 +309,7 @@ impl Controller {
         self.speed_tick += 1;
         if self.speed_tick >= self.d.speed_div {
             self.speed_tick = 0;
-            let w = self.speed.measure(self.encoder.position());
+            let w = self.speed.measure(self.observer.angle());
             match mode {
                 Mode::Speed => {
                     self.speed_ref = self.speed_setpoint;
@@ -395,7 +410,7 @@ impl Controller {
     /// Resets the loops for a start from rest in `mode`.
     fn on_enter_active(&mut self, mode: Mode) {
         self.current.reset();
-        self.speed.reset(self.encoder.position(), 0.0);
+        self.speed.reset(self.observer.angle(), 0.0);
         self.speed_ref = 0.0;
         self.iq_ref = 0.0;
         self.id_ref = 0.0;

@@ -77,6 +77,8 @@
 //! The angle estimate is kept as whole counts (i64) plus a fraction in [−0.5, 0.5) so it
 //! keeps full resolution however far the shaft has turned.
 
+use crate::pi::saturate;
+
 /// Damping ratio of the error dynamics (critically damped). [1]
 pub const DAMPING: f32 = 1.0;
 
@@ -103,7 +105,8 @@ impl EstimatedAngle {
             .whole
             .wrapping_sub(earlier.whole)
             .clamp(-1 << 24, 1 << 24);
-        whole as f32 + (self.frac - earlier.frac)
+        // Through i32 (exact after the clamp): a single vcvt on the M4F, no __aeabi_l2f.
+        whole as i32 as f32 + (self.frac - earlier.frac)
     }
 }
 
@@ -151,13 +154,14 @@ impl SpeedObserver {
     #[inline]
     pub fn update(&mut self, position: i64) {
         let diff = position.wrapping_sub(self.angle.whole);
-        // Comparison saturation: f32::clamp asserts lo <= hi (a panic path on the M4F).
-        let mut e = diff.clamp(-(1 << 24), 1 << 24) as f32 - self.angle.frac;
-        if e > MAX_ERROR_COUNTS {
-            e = MAX_ERROR_COUNTS;
-        } else if e < -MAX_ERROR_COUNTS {
-            e = -MAX_ERROR_COUNTS;
-        }
+        // Comparison saturation (no f32::clamp panic path or fmaxf call on the M4F).
+        let e = saturate(
+            // Through i32: i64 → f32 is a library call (__aeabi_l2f) on the M4F, i32 → f32
+            // one vcvt; the clamp makes the narrowing exact.
+            diff.clamp(-(1 << 24), 1 << 24) as i32 as f32 - self.angle.frac,
+            -MAX_ERROR_COUNTS,
+            MAX_ERROR_COUNTS,
+        );
         self.speed_i += self.ki_t * e;
         self.speed = self.speed_i + self.kp * e;
         self.advance();
@@ -179,7 +183,8 @@ impl SpeedObserver {
         let x = frac + 0.5;
         let mut k = x as i32;
         if (k as f32) > x {
-            k -= 1;
+            // Saturating: x below i32::MIN (a diverged, unvalidated loop) must not panic.
+            k = k.saturating_sub(1);
         }
         self.angle.whole = self.angle.whole.wrapping_add(k as i64);
         self.angle.frac = frac - k as f32;

@@ -279,7 +279,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::SweepPrecharge(a) => crate::simulate::run_sweep_precharge(&rig, a),
         Command::Commission(a) => crate::pending::run_commission(&rig, a),
         Command::Tune(a) => crate::pending::run_tune(&rig, a),
-        Command::Ingest(a) => crate::pending::run_ingest(&rig, a),
+        Command::Ingest(a) => crate::ingest::run_ingest(a),
         Command::Diagnose(a) => crate::pending::run_diagnose(&rig, a),
     }
 }

@@ -8,12 +8,14 @@
 //! - [`rig_file`]: the rig-file format, TOML of [`plant_model::Rig`].
 //! - [`study`]: the paper's accumulator study (Section 4.3).
 //! - [`simulate`]: the closed-loop runs behind `demo`, `simulate` and `sweep-precharge`.
+//! - [`ingest`]: the firmware's defmt telemetry (decoded text) to a bench log.
 //! - [`pending`]: the subcommands of other issues, routed but not built yet.
 //! - [`atomic_file`]: output files appear whole or not at all.
 
 pub mod atomic_file;
 pub mod bench_log;
 pub mod cli;
+pub mod ingest;
 pub mod pending;
 pub mod plots;
 pub mod pulsation;

@@ -1,9 +1,9 @@
 //! Placeholder for the subcommands of other issues: commissioning and tuning (issue 8),
-//! ingest and diagnosis (issue 5). Each moves to its own module when its issue lands.
+//! diagnosis (issue 5). Each moves to its own module when its issue lands.
 //! Those that take a bench log read and check it first, so a bad log is reported (exit 2)
 //! already, before the missing feature is.
 
-use crate::cli::{CliError, CommissionArgs, DiagnoseArgs, IngestArgs, TuneArgs};
+use crate::cli::{CliError, CommissionArgs, DiagnoseArgs, TuneArgs};
 use plant_model::Rig;
 
 /// `eha commission`.
@@ -20,14 +20,6 @@ pub fn run_tune(_rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
     Err(CliError::NotYetImplemented {
         command: "tune",
         issue: 8,
-    })
-}
-
-/// `eha ingest`.
-pub fn run_ingest(_rig: &Rig, _args: &IngestArgs) -> Result<(), CliError> {
-    Err(CliError::NotYetImplemented {
-        command: "ingest",
-        issue: 5,
     })
 }
 

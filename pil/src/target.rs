@@ -1,0 +1,138 @@
+//! The PIL run on the target: the scenario in closed loop, telemetry out, the loop steps
+//! measured beside it, the figures and the exit code.
+
+use crate::icount::{self, Tally};
+use closed_loop::{by_name, controller_config, ClosedLoop};
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use defmt_semihosting as _;
+use firmware::current_loop::CurrentLoop;
+use firmware::pressure_loop::PressureLoop;
+use firmware::speed_loop::SpeedLoop;
+use firmware::transforms::Dq;
+use firmware::Measurements;
+use plant_model::Rig;
+
+/// The scenario: the paper's low-speed pressure holding.
+const SCENARIO: &str = "pressure-hold";
+/// Simulated time. [s]
+const DURATION_S: f64 = 0.5;
+/// Sensor-noise seed; the host run uses the same (`eha simulate --seed 1`).
+const SEED: u64 = 1;
+/// Telemetry rate: the rate of the host simulator's bench logs (`eha simulate`), so the two
+/// logs have the same instants. [Hz]
+const LOG_RATE_HZ: f64 = 2000.0;
+
+#[entry]
+fn main() -> ! {
+    let code = match run() {
+        Ok(()) => 0,
+        Err(()) => 1,
+    };
+    semihosting::process::exit(code)
+}
+
+fn run() -> Result<(), ()> {
+    let Some(mut cp) = cortex_m::Peripherals::take() else {
+        defmt::error!("PIL: core peripherals already taken");
+        return Err(());
+    };
+    icount::start(&mut cp.SYST);
+    let per_tick = icount::measured_instructions_per_tick();
+
+    let Some(scenario) = by_name(SCENARIO) else {
+        defmt::error!("PIL: no scenario {=str}", SCENARIO);
+        return Err(());
+    };
+    let rig = Rig::nominal();
+    let config = controller_config(&rig);
+    let mut cl = match ClosedLoop::new(&rig, &config, scenario, SEED) {
+        Ok(cl) => cl,
+        Err(e) => {
+            defmt::error!("PIL: cannot build the loop: {}", defmt::Display2Format(&e));
+            return Err(());
+        }
+    };
+    let period = cl.period_s();
+    let every = libm::round(1.0 / LOG_RATE_HZ / period).max(1.0) as u64;
+    let steps = libm::ceil(DURATION_S / period) as u64;
+
+    // Separate instances of the controller's loops, fed each period with what the
+    // controller saw (the ADC counts, the telemetry's angle, speeds and references): the
+    // same code as inside `Controller::on_current_sample`, bracketed alone.
+    let mut current = CurrentLoop::new(&config);
+    let mut speed = SpeedLoop::new(&config);
+    let mut pressure = PressureLoop::new(&config);
+    pressure.reset(scenario.initial_pressure_pa as f32, 0.0);
+    pressure.set_target(closed_loop::scenario::HOLD_PRESSURE_PA as f32);
+    let pole_pairs = config.motor.pole_pairs as f32;
+
+    let (mut t_empty, mut t_step, mut t_current, mut t_speed, mut t_pressure) = (
+        Tally::default(),
+        Tally::default(),
+        Tally::default(),
+        Tally::default(),
+        Tally::default(),
+    );
+    let mut rows: u32 = 0;
+    for k in 0..steps {
+        let mut m = Measurements::default();
+        let s = t_step.measure(&mut cl, |cl| {
+            cl.step_with(|seen| {
+                m = seen;
+                seen
+            })
+        });
+        if k % every == 0 {
+            s.telemetry.emit();
+            rows += 1;
+        }
+        let tel = s.telemetry;
+        t_empty.measure((), |()| ());
+        t_current.measure(&mut current, |c| {
+            c.step(
+                &m,
+                tel.theta_m_rad * pole_pairs,
+                Dq {
+                    d: 0.0,
+                    q: tel.iq_ref_a,
+                },
+                tel.speed_rad_s * pole_pairs,
+            )
+        });
+        t_speed.measure(&mut speed, |sl| {
+            sl.step(tel.speed_ref_rad_s, tel.speed_rad_s)
+        });
+        t_pressure.measure(&mut pressure, |pl| pl.step(tel.p_pa));
+    }
+
+    defmt::info!(
+        "PIL current_loop_instructions={=f64} speed_loop_instructions={=f64} pressure_loop_instructions={=f64} closed_loop_step_instructions={=f64} bracket_overhead_instructions={=f64} instructions_per_tick_measured={=f64} calls={=u64} simulated_s={=f64} telemetry_rows={=u32}",
+        t_current.mean_instructions(&t_empty),
+        t_speed.mean_instructions(&t_empty),
+        t_pressure.mean_instructions(&t_empty),
+        t_step.mean_instructions(&t_empty),
+        t_empty.mean_ticks() * icount::INSTRUCTIONS_PER_TICK as f64,
+        per_tick,
+        t_current.calls(),
+        cl.time_s(),
+        rows
+    );
+    Ok(())
+}
+
+#[defmt::panic_handler]
+fn defmt_panic() -> ! {
+    semihosting::process::exit(101)
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::error!("PIL panicked: {}", defmt::Display2Format(info));
+    semihosting::process::exit(101)
+}
+
+#[exception]
+unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+    defmt::error!("PIL: HardFault");
+    semihosting::process::exit(102)
+}
