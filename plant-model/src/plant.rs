@@ -27,6 +27,15 @@
 //! booked, see below) so RK4 never integrates across a switching surface with a stale sign.
 //! The fine-step comparison is in this crate's tests (`integration_error_against_fine_step`).
 //!
+//! Cost: everything that depends on the shaft angle alone (rotor phasors, magnet-flux
+//! harmonics, cogging, the pump's displacement factor) is evaluated once per RK4 stage and
+//! kept for the step's end state, where `sample`, `observe`, the projection and the next
+//! step's first stage all read it. The stage phasors come from the step's start phasor
+//! rotated through the stage's angle increment (a Taylor series exact to rounding for the
+//! ≤ 0.1 rad a step turns, libm beyond), and the end phasor is carried to the next step the
+//! same way, recomputed from the angle every 1024 steps — no `sincos` in the steady loop,
+//! and the same numbers to ≈ 1e-16 rad.
+//!
 //! # Energy
 //! Input, losses and the work of projections are integrated as extra states with the same
 //! RK4, the stored energy is a function of the state, so
@@ -38,7 +47,7 @@ use crate::accumulator::{Absorber, GasCharge};
 use crate::cylinder::Cylinder;
 use crate::friction::{Friction, Slip};
 use crate::inverter::{dq_to_abc, pole_to_dq, Inverter};
-use crate::motor::{Motor, Phasor};
+use crate::motor::{MagnetFlux, Motor, Phasor};
 use crate::pump::Pump;
 use crate::rig::{Rig, RigError};
 use crate::sensors::{SensorReadings, Sensors};
@@ -266,6 +275,37 @@ struct Aux {
     p_fill: f64,
 }
 
+/// Everything of a derivative evaluation that depends on the shaft angle alone: the rotor
+/// phasors, the magnet flux with its harmonics, the cogging torque and the pump's
+/// displacement factor. Kept for the present state so that `sample`, `observe`, the
+/// projection and the next step's first RK4 stage share one evaluation.
+#[derive(Clone, Copy, Debug)]
+struct AngleTerms {
+    /// The shaft angle these belong to. [rad]
+    theta: f64,
+    rot_m: Phasor,
+    rot_e: Phasor,
+    flux: MagnetFlux,
+    /// Cogging torque. [N·m]
+    t_cog: f64,
+    /// Pump displacement factor. [1]
+    factor: f64,
+}
+
+/// The shaft-angle phasor of the present state, carried from step to step by rotation
+/// through the step's angle increment (no `sincos`), re-derived from the angle itself every
+/// [`ROTOR_RESYNC_STEPS`] steps so rounding cannot accumulate (≈ 1e-16 rad per rotation).
+#[derive(Clone, Copy, Debug)]
+struct RotorPhasor {
+    /// The shaft angle. [rad]
+    theta: f64,
+    phasor: Phasor,
+    rotations: u32,
+}
+
+/// Steps carried by rotation before the rotor phasor is computed afresh.
+const ROTOR_RESYNC_STEPS: u32 = 1024;
+
 /// The actuator model.
 #[derive(Clone, Debug)]
 pub struct Plant {
@@ -292,6 +332,8 @@ pub struct Plant {
     projection_loss_j: f64,
     stored0_j: f64,
     last_inputs: Inputs,
+    rotor: RotorPhasor,
+    angle: AngleTerms,
 }
 
 impl Plant {
@@ -381,7 +423,26 @@ impl Plant {
             projection_loss_j: 0.0,
             stored0_j: 0.0,
             last_inputs: Inputs::duties([0.5; 3], false),
+            rotor: RotorPhasor {
+                theta: init.theta_m_rad,
+                phasor: Phasor::of(init.theta_m_rad),
+                rotations: 0,
+            },
+            angle: AngleTerms {
+                theta: f64::NAN,
+                rot_m: Phasor { cos: 1.0, sin: 0.0 },
+                rot_e: Phasor { cos: 1.0, sin: 0.0 },
+                flux: MagnetFlux {
+                    d_wb: 0.0,
+                    q_wb: 0.0,
+                    d_slope_wb: 0.0,
+                    q_slope_wb: 0.0,
+                },
+                t_cog: 0.0,
+                factor: 1.0,
+            },
         };
+        plant.angle = plant.angle_terms(init.theta_m_rad);
         plant.stored0_j = plant.stored_energy_j(&plant.x);
         Ok(plant)
     }
@@ -527,7 +588,7 @@ impl Plant {
 
     /// Reads every sensor at the present instant (the ADC trigger at the PWM centre).
     pub fn sample(&mut self) -> SensorReadings {
-        let e = Phasor::of(self.x[ix::THETA]).pow(self.pole_pairs);
+        let e = self.angle_terms(self.x[ix::THETA]).rot_e;
         let i_abc = dq_to_abc(self.x[ix::ID], self.x[ix::IQ], e.sin, e.cos);
         let p_sensed = if self.sensor_lag_s > 0.0 {
             self.x[ix::P_SENSOR]
@@ -633,12 +694,66 @@ impl Plant {
 
     fn rk4(&mut self, h: f64, inputs: &Inputs) {
         let x0 = self.x;
-        let (k1, _) = self.derivative(&x0, inputs);
-        let (k2, _) = self.derivative(&axpy(&x0, 0.5 * h, &k1), inputs);
-        let (k3, _) = self.derivative(&axpy(&x0, 0.5 * h, &k2), inputs);
-        let (k4, _) = self.derivative(&axpy(&x0, h, &k3), inputs);
+        let a0 = self.angle_terms(x0[ix::THETA]);
+        let stage = |x: &Vector| {
+            let a = self.angle_terms_rotated(&a0, x[ix::THETA]);
+            self.derivative_at(x, inputs, &a).0
+        };
+        let k1 = self.derivative_at(&x0, inputs, &a0).0;
+        let k2 = stage(&axpy(&x0, 0.5 * h, &k1));
+        let k3 = stage(&axpy(&x0, 0.5 * h, &k2));
+        let k4 = stage(&axpy(&x0, h, &k3));
         for i in 0..ix::N {
             self.x[i] = x0[i] + h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+        let theta = self.x[ix::THETA];
+        self.rotor = if self.rotor.rotations >= ROTOR_RESYNC_STEPS {
+            RotorPhasor {
+                theta,
+                phasor: Phasor::of(theta),
+                rotations: 0,
+            }
+        } else {
+            RotorPhasor {
+                theta,
+                phasor: a0.rot_m * Phasor::small(theta - a0.theta),
+                rotations: self.rotor.rotations + 1,
+            }
+        };
+        self.angle = self.angle_terms(theta);
+    }
+
+    /// The shaft-angle terms at `theta`: the kept ones when they belong to it, else computed
+    /// (from the kept rotor phasor when that belongs to it, else with one `sincos`).
+    #[inline]
+    fn angle_terms(&self, theta: f64) -> AngleTerms {
+        if theta == self.angle.theta {
+            self.angle
+        } else if theta == self.rotor.theta {
+            self.angle_terms_of(theta, self.rotor.phasor)
+        } else {
+            self.angle_terms_of(theta, Phasor::of(theta))
+        }
+    }
+
+    /// The shaft-angle terms at `theta` near `a0.theta` (an RK4 stage), its phasor by rotating
+    /// `a0`'s through the difference.
+    #[inline]
+    fn angle_terms_rotated(&self, a0: &AngleTerms, theta: f64) -> AngleTerms {
+        self.angle_terms_of(theta, a0.rot_m * Phasor::small(theta - a0.theta))
+    }
+
+    /// One sincos per evaluation at most: every harmonic is a power of the shaft-angle phasor.
+    #[inline]
+    fn angle_terms_of(&self, theta: f64, rot_m: Phasor) -> AngleTerms {
+        let rot_e = rot_m.pow(self.pole_pairs);
+        AngleTerms {
+            theta,
+            rot_m,
+            rot_e,
+            flux: self.motor.magnet_flux_at(rot_e),
+            t_cog: self.motor.cogging_torque_at(rot_m),
+            factor: self.pump.displacement_factor_at(theta, rot_m),
         }
     }
 
@@ -651,10 +766,13 @@ impl Plant {
             Slip::Stuck => true,
             Slip::Sliding(dir) => self.x[ix::OMEGA] * dir <= 0.0,
         };
-        let piston_switch = match self.discrete.piston {
-            Slip::Stuck => true,
-            Slip::Sliding(dir) => self.x[ix::V] * dir <= 0.0,
-        };
+        let piston_free = inputs.piston.is_none() && !self.cylinder.blocked;
+        let shaft_switch = shaft_switch && !matches!(inputs.drive, Drive::ShaftSpeed { .. });
+        let piston_switch = piston_free
+            && match self.discrete.piston {
+                Slip::Stuck => true,
+                Slip::Sliding(dir) => self.x[ix::V] * dir <= 0.0,
+            };
         let needs = (shaft_switch && self.shaft_friction.is_active())
             || (piston_switch && self.piston_friction.is_active());
         let aux = if needs {
@@ -673,7 +791,6 @@ impl Plant {
             self.x[ix::OMEGA] = w_new;
         }
         // Piston stick/slip.
-        let piston_free = inputs.piston.is_none() && !self.cylinder.blocked;
         if piston_free && self.piston_friction.is_active() {
             let v = self.x[ix::V];
             let (slip, v_new) =
@@ -758,19 +875,22 @@ impl Plant {
     /// The right-hand side of the state equations.
     #[inline]
     fn derivative(&self, x: &Vector, inputs: &Inputs) -> (Vector, Aux) {
+        self.derivative_at(x, inputs, &self.angle_terms(x[ix::THETA]))
+    }
+
+    /// The right-hand side with the shaft-angle terms `at` of `x` supplied.
+    #[inline]
+    fn derivative_at(&self, x: &Vector, inputs: &Inputs, at: &AngleTerms) -> (Vector, Aux) {
         let mut dx = [0.0; ix::N];
         let mut aux = Aux::default();
-        let theta = x[ix::THETA];
         let omega = x[ix::OMEGA];
         let (i_d, i_q) = (x[ix::ID], x[ix::IQ]);
         let p_n = self.motor.pole_pairs;
         let omega_e = p_n * omega;
-        // One sincos per evaluation: every harmonic is a power of the shaft-angle phasor.
-        let rot_m = Phasor::of(theta);
-        let rot_e = rot_m.pow(self.pole_pairs);
+        let rot_e = at.rot_e;
 
         // --- motor and inverter (eq. 1–3, 17–19)
-        let flux = self.motor.magnet_flux_at(rot_e);
+        let flux = at.flux;
         let (s_e, c_e) = (rot_e.sin, rot_e.cos);
         aux.i_abc = dq_to_abc(i_d, i_q, s_e, c_e);
         let mut p_in = 0.0;
@@ -800,12 +920,12 @@ impl Plant {
             Drive::Currents { .. } | Drive::ShaftSpeed { .. } => {}
         }
         aux.t_em = self.motor.torque_nm(i_d, i_q, &flux);
-        aux.t_cog = self.motor.cogging_torque_at(rot_m);
+        aux.t_cog = at.t_cog;
         dx[ix::E_CU] = 1.5 * self.motor.r_s_ohm * (i_d * i_d + i_q * i_q);
 
         // --- pump (eq. 9, 20) and shaft (eq. 4)
         let (p_a, p_b) = (x[ix::PA], x[ix::PB]);
-        let factor = self.pump.displacement_factor_at(theta, rot_m);
+        let factor = at.factor;
         aux.t_pump = self.pump.load_torque(p_a, p_b, factor);
         aux.shaft_drive = aux.t_em + aux.t_cog - aux.t_pump - self.shaft_viscous * omega;
         let t_fric = self.shaft_friction.force(self.discrete.shaft);

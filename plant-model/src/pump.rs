@@ -122,9 +122,12 @@ impl Pump {
         // Smallest piston angle φ0 in [0, pitch); pistons at φ0 + j·pitch deliver while < π.
         let turns = libm::floor(theta / self.pitch);
         let phi0 = (theta - turns * self.pitch).clamp(0.0, self.pitch);
-        let j = rem_euclid(turns, self.pistons as f64) as usize;
-        let m = libm::ceil((PI - phi0) / self.pitch) as u32;
-        let k = (m.saturating_sub(self.m_base).min(2)) as usize;
+        // `turns` is a whole number: its residue in integers (saturating far beyond any
+        // reachable angle, where any index in range would do).
+        let j = (turns as i64).rem_euclid(i64::from(self.pistons.max(1))) as usize;
+        // m = ⌈(π − φ0)/pitch⌉ pistons deliver; (π − φ0)/pitch lies in [z/2 − 1, z/2], so
+        // m − m_base (floored at 0) is 1 exactly when the ratio exceeds m_base, else 0.
+        let k = usize::from((PI - phi0) / self.pitch > self.m_base as f64);
         let (Some(gain), Some(phase), Some(back)) = (
             self.series_gain.get(k),
             self.series_phase.get(k),
@@ -161,15 +164,5 @@ impl Pump {
     #[inline]
     pub fn load_torque(&self, p_a: f64, p_b: f64, factor: f64) -> f64 {
         self.displacement_m3_per_rad * factor * (p_a - p_b)
-    }
-}
-
-#[inline]
-fn rem_euclid(x: f64, m: f64) -> f64 {
-    let r = x - m * libm::floor(x / m);
-    if r >= m || r < 0.0 {
-        0.0
-    } else {
-        r
     }
 }
