@@ -35,6 +35,18 @@ impl Inverter {
         }
     }
 
+    /// Whether the dead-time error is modelled (then the pole voltages depend on the currents).
+    #[inline]
+    pub fn has_dead_time(&self) -> bool {
+        self.dead_time_error_v > 0.0
+    }
+
+    /// Average pole voltages without dead time, d_x·U_dc. [V]
+    #[inline]
+    pub fn pole_voltages_ideal(&self, duties: &[f64; 3]) -> [f64; 3] {
+        duties.map(|d| d * self.u_dc_v)
+    }
+
     /// Average pole voltages (against the negative rail) for `duties` and phase currents
     /// `i_abc` (positive into the motor). [V]
     #[inline]

@@ -260,19 +260,25 @@ struct Discrete {
     extinguished: bool,
 }
 
-/// Intermediate quantities of one derivative evaluation, reused by [`Plant::observe`].
+/// The inverter-driven part of one evaluation.
 #[derive(Clone, Copy, Debug, Default)]
-struct Aux {
+struct Electrical {
     u_d: f64,
     u_q: f64,
-    i_abc: [f64; 3],
-    t_em: f64,
-    t_cog: f64,
-    t_pump: f64,
+    did: f64,
+    diq: f64,
+    /// Electrical power into the motor terminals. [W]
+    p_in: f64,
+}
+
+/// The drives of the two friction-bearing bodies in one evaluation (what the stick/slip
+/// decisions need).
+#[derive(Clone, Copy, Debug, Default)]
+struct Aux {
+    /// Net shaft torque except friction. [N·m]
     shaft_drive: f64,
+    /// Net piston force except friction. [N]
     piston_drive: f64,
-    q_geo: f64,
-    p_fill: f64,
 }
 
 /// Everything of a derivative evaluation that depends on the shaft angle alone: the rotor
@@ -601,21 +607,22 @@ impl Plant {
 
     /// True physical quantities now, with the inputs of the last step.
     pub fn observe(&self) -> Observables {
-        let inputs = self.last_inputs;
-        let (_, aux) = self.derivative(&self.x, &inputs);
         let x = &self.x;
+        let at = self.angle_terms(x[ix::THETA]);
+        // Only the drive side of an evaluation: the hydraulic flows are not observed.
+        let el = self.electrical(x, &self.last_inputs, &at);
         Observables {
             t_s: self.t_s,
             i_d_a: x[ix::ID],
             i_q_a: x[ix::IQ],
-            i_abc_a: aux.i_abc,
-            u_d_v: aux.u_d,
-            u_q_v: aux.u_q,
+            i_abc_a: dq_to_abc(x[ix::ID], x[ix::IQ], at.rot_e.sin, at.rot_e.cos),
+            u_d_v: el.u_d,
+            u_q_v: el.u_q,
             theta_m_rad: x[ix::THETA],
             omega_m_rad_s: x[ix::OMEGA],
-            torque_em_nm: aux.t_em,
-            torque_cogging_nm: aux.t_cog,
-            torque_pump_nm: aux.t_pump,
+            torque_em_nm: self.motor.torque_nm(x[ix::ID], x[ix::IQ], &at.flux),
+            torque_cogging_nm: at.t_cog,
+            torque_pump_nm: self.pump.load_torque(x[ix::PA], x[ix::PB], at.factor),
             p_a_pa: x[ix::PA],
             p_b_pa: x[ix::PB],
             p_sensor_pa: if self.sensor_lag_s > 0.0 {
@@ -623,8 +630,8 @@ impl Plant {
             } else {
                 x[ix::PA]
             },
-            p_fill_pa: aux.p_fill,
-            pump_flow_m3_s: aux.q_geo,
+            p_fill_pa: x[ix::FILL_PGAS] - ATMOSPHERE_PA,
+            pump_flow_m3_s: self.pump.geometric_flow(x[ix::OMEGA], at.factor),
             absorber_oil_m3: x[ix::ABS_OIL],
             absorber_flow_m3_s: x[ix::ABS_Q],
             x_m: x[ix::X],
@@ -878,6 +885,47 @@ impl Plant {
         self.derivative_at(x, inputs, &self.angle_terms(x[ix::THETA]))
     }
 
+    /// The inverter's d-q voltages and the current derivatives (eq. 2) driven by them; zero
+    /// unless the inverter drives and the currents are alive. The phase currents are formed
+    /// only when the pole voltages depend on them (dead time, free-wheeling diodes).
+    #[inline]
+    fn electrical(&self, x: &Vector, inputs: &Inputs, at: &AngleTerms) -> Electrical {
+        let Drive::Inverter { duties, enabled } = inputs.drive else {
+            return Electrical::default();
+        };
+        if !enabled && self.discrete.extinguished {
+            return Electrical::default();
+        }
+        let (i_d, i_q) = (x[ix::ID], x[ix::IQ]);
+        let (s_e, c_e) = (at.rot_e.sin, at.rot_e.cos);
+        let v_pole = if enabled && !self.inverter.has_dead_time() {
+            self.inverter.pole_voltages_ideal(&duties)
+        } else {
+            let i_abc = dq_to_abc(i_d, i_q, s_e, c_e);
+            if enabled {
+                self.inverter.pole_voltages(&duties, &i_abc)
+            } else {
+                // Free-wheeling diodes: a motor-bound current through the lower diode (pole
+                // at 0 V), a returning one through the upper (U_dc).
+                let u = self.inverter.u_dc_v;
+                let pole = |i: f64| if i > 0.0 { 0.0 } else { u };
+                [pole(i_abc[0]), pole(i_abc[1]), pole(i_abc[2])]
+            }
+        };
+        let (u_d, u_q) = pole_to_dq(&v_pole, s_e, c_e);
+        let omega_e = self.motor.pole_pairs * x[ix::OMEGA];
+        let (did, diq) = self
+            .motor
+            .current_derivatives(u_d, u_q, i_d, i_q, omega_e, &at.flux);
+        Electrical {
+            u_d,
+            u_q,
+            did,
+            diq,
+            p_in: 1.5 * (u_d * i_d + u_q * i_q),
+        }
+    }
+
     /// The right-hand side with the shaft-angle terms `at` of `x` supplied.
     #[inline]
     fn derivative_at(&self, x: &Vector, inputs: &Inputs, at: &AngleTerms) -> (Vector, Aux) {
@@ -885,59 +933,32 @@ impl Plant {
         let mut aux = Aux::default();
         let omega = x[ix::OMEGA];
         let (i_d, i_q) = (x[ix::ID], x[ix::IQ]);
-        let p_n = self.motor.pole_pairs;
-        let omega_e = p_n * omega;
-        let rot_e = at.rot_e;
+        let flux = at.flux;
 
         // --- motor and inverter (eq. 1–3, 17–19)
-        let flux = at.flux;
-        let (s_e, c_e) = (rot_e.sin, rot_e.cos);
-        aux.i_abc = dq_to_abc(i_d, i_q, s_e, c_e);
-        let mut p_in = 0.0;
-        match inputs.drive {
-            Drive::Inverter { duties, enabled } => {
-                if enabled || !self.discrete.extinguished {
-                    let v_pole = if enabled {
-                        self.inverter.pole_voltages(&duties, &aux.i_abc)
-                    } else {
-                        // Free-wheeling diodes: a motor-bound current through the lower
-                        // diode (pole at 0 V), a returning one through the upper (U_dc).
-                        let u = self.inverter.u_dc_v;
-                        let pole = |i: f64| if i > 0.0 { 0.0 } else { u };
-                        [pole(aux.i_abc[0]), pole(aux.i_abc[1]), pole(aux.i_abc[2])]
-                    };
-                    let (u_d, u_q) = pole_to_dq(&v_pole, s_e, c_e);
-                    aux.u_d = u_d;
-                    aux.u_q = u_q;
-                    let (did, diq) = self
-                        .motor
-                        .current_derivatives(u_d, u_q, i_d, i_q, omega_e, &flux);
-                    dx[ix::ID] = did;
-                    dx[ix::IQ] = diq;
-                    p_in = 1.5 * (u_d * i_d + u_q * i_q);
-                }
-            }
-            Drive::Currents { .. } | Drive::ShaftSpeed { .. } => {}
-        }
-        aux.t_em = self.motor.torque_nm(i_d, i_q, &flux);
-        aux.t_cog = at.t_cog;
+        let el = self.electrical(x, inputs, at);
+        dx[ix::ID] = el.did;
+        dx[ix::IQ] = el.diq;
+        let mut p_in = el.p_in;
+        let t_em = self.motor.torque_nm(i_d, i_q, &flux);
+        let t_cog = at.t_cog;
         dx[ix::E_CU] = 1.5 * self.motor.r_s_ohm * (i_d * i_d + i_q * i_q);
 
         // --- pump (eq. 9, 20) and shaft (eq. 4)
         let (p_a, p_b) = (x[ix::PA], x[ix::PB]);
         let factor = at.factor;
-        aux.t_pump = self.pump.load_torque(p_a, p_b, factor);
-        aux.shaft_drive = aux.t_em + aux.t_cog - aux.t_pump - self.shaft_viscous * omega;
+        let t_pump = self.pump.load_torque(p_a, p_b, factor);
+        aux.shaft_drive = t_em + t_cog - t_pump - self.shaft_viscous * omega;
         let t_fric = self.shaft_friction.force(self.discrete.shaft);
         dx[ix::THETA] = omega;
         match inputs.drive {
             Drive::ShaftSpeed { .. } => {
                 // The prescribed motion is supplied by the drive: its power is the input.
-                p_in = (aux.t_pump + self.shaft_viscous * omega + t_fric - aux.t_cog) * omega;
+                p_in = (t_pump + self.shaft_viscous * omega + t_fric - t_cog) * omega;
             }
             _ => {
                 if matches!(inputs.drive, Drive::Currents { .. }) {
-                    p_in = aux.t_em * omega + dx[ix::E_CU];
+                    p_in = t_em * omega + dx[ix::E_CU];
                 }
                 if self.discrete.shaft == Slip::Stuck && self.shaft_friction.is_active() {
                     dx[ix::THETA] = 0.0;
@@ -951,8 +972,7 @@ impl Plant {
 
         // --- hydraulics (eq. 9–12, 22–26)
         let p_fill = x[ix::FILL_PGAS] - ATMOSPHERE_PA;
-        aux.p_fill = p_fill;
-        aux.q_geo = self.pump.geometric_flow(omega, factor);
+        let q_geo = self.pump.geometric_flow(omega, factor);
         let q_int = self.pump.internal_leakage * (p_a - p_b);
         let q_ext_a = (self.pump.external_leakage + self.pump.extra_leakage) * (p_a - p_fill);
         let q_ext_b = self.pump.external_leakage * (p_b - p_fill);
@@ -965,8 +985,8 @@ impl Plant {
         let (xp, vp) = (x[ix::X], x[ix::V]);
         let (v1, v2) = self.cylinder.volumes(xp);
         let area = self.cylinder.area_m2;
-        let net_a = aux.q_geo - q_int - q_ext_a - q_cyl + q_chk_a - q_rel_a - q_abs - area * vp;
-        let net_b = -aux.q_geo + q_int - q_ext_b + q_cyl + q_chk_b - q_rel_b + area * vp;
+        let net_a = q_geo - q_int - q_ext_a - q_cyl + q_chk_a - q_rel_a - q_abs - area * vp;
+        let net_b = -q_geo + q_int - q_ext_b + q_cyl + q_chk_b - q_rel_b + area * vp;
         dx[ix::PA] = self.beta / v1 * net_a;
         dx[ix::PB] = self.beta / v2 * net_b;
         dx[ix::FILL_OIL] = q_ext_a + q_ext_b + q_rel_a + q_rel_b - q_chk_a - q_chk_b;
