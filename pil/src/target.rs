@@ -8,7 +8,8 @@ use defmt_semihosting as _;
 use firmware::current_loop::CurrentLoop;
 use firmware::pressure_loop::PressureLoop;
 use firmware::speed_loop::SpeedLoop;
-use firmware::transforms::Dq;
+use firmware::svpwm::modulate;
+use firmware::transforms::{inverse_park, sin_cos, Dq};
 use firmware::Measurements;
 use plant_model::Rig;
 
@@ -73,6 +74,9 @@ fn run() -> Result<(), ()> {
         Tally::default(),
         Tally::default(),
     );
+    // Two parts of the current-loop step, for what dominates it: the sine/cosine pair of
+    // the angle (micromath) and the space-vector modulator (with its division by U_dc).
+    let (mut t_sin_cos, mut t_svpwm) = (Tally::default(), Tally::default());
     let mut rows: u32 = 0;
     for k in 0..steps {
         let mut m = Measurements::default();
@@ -99,6 +103,20 @@ fn run() -> Result<(), ()> {
                 tel.speed_rad_s * pole_pairs,
             )
         });
+        let sc = t_sin_cos.measure(tel.theta_m_rad * pole_pairs, sin_cos);
+        t_svpwm.measure(
+            (
+                inverse_park(
+                    Dq {
+                        d: tel.ud_v,
+                        q: tel.uq_v,
+                    },
+                    sc,
+                ),
+                tel.udc_v,
+            ),
+            |(v, u_dc)| modulate(v, u_dc),
+        );
         t_speed.measure(&mut speed, |sl| {
             sl.step(tel.speed_ref_rad_s, tel.speed_rad_s)
         });
@@ -106,11 +124,13 @@ fn run() -> Result<(), ()> {
     }
 
     defmt::info!(
-        "PIL current_loop_instructions={=f64} speed_loop_instructions={=f64} pressure_loop_instructions={=f64} closed_loop_step_instructions={=f64} bracket_overhead_instructions={=f64} instructions_per_tick_measured={=f64} calls={=u64} simulated_s={=f64} telemetry_rows={=u32}",
+        "PIL current_loop_instructions={=f64} speed_loop_instructions={=f64} pressure_loop_instructions={=f64} closed_loop_step_instructions={=f64} sin_cos_instructions={=f64} svpwm_instructions={=f64} bracket_overhead_instructions={=f64} instructions_per_tick_measured={=f64} calls={=u64} simulated_s={=f64} telemetry_rows={=u32}",
         t_current.mean_instructions(&t_empty),
         t_speed.mean_instructions(&t_empty),
         t_pressure.mean_instructions(&t_empty),
         t_step.mean_instructions(&t_empty),
+        t_sin_cos.mean_instructions(&t_empty),
+        t_svpwm.mean_instructions(&t_empty),
         t_empty.mean_ticks() * icount::INSTRUCTIONS_PER_TICK as f64,
         per_tick,
         t_current.calls(),

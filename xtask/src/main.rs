@@ -7,12 +7,18 @@
 //!    use against the budget (64 KiB / 16 KiB, so it also fits an STM32G431), written to
 //!    `target/firmware-size.json`.
 //!
-//! `cargo xtask fw-size` does step 4 alone.
+//! 5. the processor-in-the-loop run in QEMU ([`pil`]): the control core and the plant on
+//!    the Cortex-M4F, telemetry through defmt and `eha ingest`, compared with the host run,
+//!    instruction counts against `pil/budget.toml`, figures in `target/pil/report.json`.
+//!
+//! `cargo xtask fw-size` does step 4 alone, `cargo xtask pil` step 5.
 
 use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+mod pil;
 
 const TARGET: &str = "thumbv7em-none-eabihf";
 const FLASH_BUDGET: u64 = 64 * 1024;
@@ -23,8 +29,9 @@ fn main() {
     let result = match args.first().map(String::as_str) {
         Some("test") => test(),
         Some("fw-size") => firmware().map(|_| ()),
+        Some("pil") => ensure_target().and_then(|()| pil::pil()),
         _ => {
-            eprintln!("usage: cargo xtask <test | fw-size>");
+            eprintln!("usage: cargo xtask <test | fw-size | pil>");
             std::process::exit(2);
         }
     };
@@ -45,6 +52,13 @@ fn cargo() -> Command {
     let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     c.current_dir(root());
     c
+}
+
+/// Cargo's target directory (`CARGO_TARGET_DIR` or `target/` at the root).
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"))
 }
 
 fn run(step: &str, cmd: &mut Command) -> Result<()> {
@@ -93,6 +107,7 @@ fn test() -> Result<()> {
     )?;
     run("host tests", cargo().args(["test", "--workspace"]))?;
     firmware()?;
+    pil::pil()?;
     eprintln!("\nxtask: all checks passed");
     Ok(())
 }
@@ -115,9 +130,7 @@ fn firmware() -> Result<(u64, u64)> {
             &format!("target.{TARGET}.rustflags=[\"-D\", \"warnings\"]"),
         ]),
     )?;
-    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target"));
+    let target_dir = target_dir();
     let elf = target_dir.join(TARGET).join("release").join("firmware");
     let (flash, ram) = image_size(&elf)?;
     let json = format!(
