@@ -130,6 +130,17 @@ pub fn pil() -> Result<()> {
     let report_path = out_dir.join("report.json");
     fs::write(&report_path, format!("{report:#}\n"))?;
     eprintln!("PIL figures in {}:\n{report:#}", report_path.display());
+    // The f32 control code and the f64 plant (libm, IEEE arithmetic in hardware or soft
+    // float) compute the same bits on both machines; the closed loop would amplify any
+    // difference, so there is no meaningful tolerance: a non-zero one means shared code
+    // took a different float path on the host (std's inherent `sin`/`sqrt`, a fused
+    // multiply-add) or a different input.
+    if let Some((name, d)) = diffs.iter().find(|(_, d)| *d != 0.0) {
+        bail!(
+            "the PIL and host runs differ ({name} by {d}): shared code must call float \
+             functions through libm/micromath on both (see target/pil/pil.csv and host.csv)"
+        );
+    }
     if current > budget * (1.0 + BUDGET_TOLERANCE_PERCENT / 100.0) {
         bail!(
             "the current-loop step takes {current:.0} instructions, more than \
