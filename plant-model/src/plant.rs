@@ -34,7 +34,10 @@
 //! rotated through the stage's angle increment (a Taylor series exact to rounding for the
 //! ≤ 0.1 rad a step turns, libm beyond), and the end phasor is carried to the next step the
 //! same way, recomputed from the angle every 1024 steps — no `sincos` in the steady loop,
-//! and the same numbers to ≈ 1e-16 rad.
+//! and the same numbers to ≈ 1e-16 rad. `observe` evaluates only the drive side (no state
+//! derivative), and the projection evaluates the model only for a body that can switch (not
+//! for a blocked or prescribed piston). The scheme itself — one RK4 step over all 19 states —
+//! is unchanged.
 //!
 //! # Energy
 //! Input, losses and the work of projections are integrated as extra states with the same
