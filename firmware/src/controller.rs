@@ -541,7 +541,9 @@ impl Controller {
             (_, None) => 0.0,
         };
         TelemetryFrame {
-            t_s: self.samples as f64 / self.d.pwm_hz,
+            // The instant the frame's measurements were sampled (the first sample is t = 0),
+            // the same clock as the plant's in a simulated bench log.
+            t_s: self.samples.saturating_sub(1) as f64 / self.d.pwm_hz,
             p_ref_pa: p_ref,
             p_pa: self.p_pa,
             speed_rad_s: self.speed.speed(),

@@ -357,9 +357,9 @@ fn compare(target: &Log, host: &Log) -> Result<Vec<(&'static str, f64)>> {
             host.rows
         );
     }
-    // Row k of both logs is the same PWM period; the firmware stamps its frame with its
-    // sample count including the current one, the host log with the plant's time at the
-    // sample, so the clocks differ by one constant offset (one period).
+    // Row k of both logs is the same PWM period; both stamp it with the instant its
+    // measurements were sampled, so the offset must be zero — checked as a constant offset
+    // so a mismatch is reported plainly.
     let (tt, th) = (column(target, "t_s")?, column(host, "t_s")?);
     let offset = match (tt.first(), th.first()) {
         (Some(a), Some(b)) => a - b,

@@ -328,7 +328,8 @@ fn telemetry_reports_what_the_controller_sees() {
         c.on_current_sample(&healthy(0));
     }
     let t = c.telemetry();
-    assert!((t.t_s - 202.0 / 20e3).abs() < 1e-9, "{}", t.t_s);
+    // 202 samples taken; the frame is stamped with the last one's instant, the first at 0.
+    assert!((t.t_s - 201.0 / 20e3).abs() < 1e-9, "{}", t.t_s);
     assert!((t.p_pa - 3e6).abs() < PA_PER_LSB);
     assert!((t.udc_v - 280.0).abs() < 1e-3);
     assert_eq!(t.mode, Mode::Pressure);
