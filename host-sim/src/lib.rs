@@ -15,6 +15,7 @@
 pub mod atomic_file;
 pub mod bench_log;
 pub mod cli;
+pub mod diagnose;
 pub mod ingest;
 pub mod pending;
 pub mod plots;
