@@ -242,6 +242,8 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         by_name("pressure-hold").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
     let step =
         by_name("pressure-step").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
+    let speed_step =
+        by_name("speed-step").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
     let meta = |scenario: &str, absorber: &str| {
         vec![
             ("source".to_string(), "simulation".to_string()),
@@ -268,6 +270,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             step.duration_s,
             meta("pressure-step", "fitted"),
         ),
+        (&plant, rig, speed_step, 0.4, meta("speed-step", "fitted")),
     ];
     let runs: Vec<Result<Run, String>> = jobs
         .par_iter()
@@ -292,7 +295,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             .unwrap_or_else(|| Err("run missing".into()))
             .map_err(CliError::Failed)
     };
-    let (with, without, stepped) = (next()?, next()?, next()?);
+    let (with, without, stepped, sped) = (next()?, next()?, next()?, next()?);
     let pw = pulsation(&with, hold, &plant);
     let po = pulsation(&without, hold, &plant);
 
@@ -300,6 +303,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     write_log(&log_path, &with.log)?;
     write_log(&out.join("pressure-hold-no-absorber.csv"), &without.log)?;
     write_log(&out.join("pressure-step.csv"), &stepped.log)?;
+    write_log(&out.join("speed-step.csv"), &sped.log)?;
 
     let mut table = String::new();
     let _ = writeln!(
@@ -475,9 +479,53 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             false,
         ),
     )?;
+    let speed_ref = sped.log.speed_ref_rad_s.clone().unwrap_or_default();
+    plot(
+        "speed step",
+        line_chart(
+            &out.join("speed_step.svg"),
+            "Speed step 0 → 50 rad/s (payload free)",
+            "t [s]",
+            "speed [rad/s], q-current [A]",
+            &[
+                Series {
+                    name: "speed reference",
+                    points: sped
+                        .log
+                        .t_s
+                        .iter()
+                        .zip(&speed_ref)
+                        .map(|(t, w)| (*t, *w))
+                        .collect(),
+                },
+                Series {
+                    name: "true shaft speed",
+                    points: sped
+                        .log
+                        .t_s
+                        .iter()
+                        .zip(&sped.speed_true_rad_s)
+                        .map(|(t, w)| (*t, *w))
+                        .collect(),
+                },
+                Series {
+                    name: "measured q-current",
+                    points: sped
+                        .log
+                        .t_s
+                        .iter()
+                        .zip(&sped.log.iq_a)
+                        .map(|(t, i)| (*t, *i))
+                        .collect(),
+                },
+            ],
+            &[],
+            false,
+        ),
+    )?;
     let _ = writeln!(
         table,
-        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, pressure_trace.svg, pulsation_spectrum.svg, pressure_step.svg",
+        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, pressure_trace.svg, pulsation_spectrum.svg, pressure_step.svg, speed_step.svg",
         out.display()
     );
     print_stdout(&table)
