@@ -33,6 +33,15 @@ pub struct Sample {
     pub outputs: Outputs,
 }
 
+/// A logged period: the telemetry after the ISR, the plant's truth at the sampling instant.
+fn record(plant: &Plant, controller: &Controller, outputs: Outputs) -> Sample {
+    Sample {
+        telemetry: controller.telemetry(),
+        truth: plant.observe(),
+        outputs,
+    }
+}
+
 /// The control core in closed loop with the plant.
 pub struct ClosedLoop {
     plant: Plant,
@@ -42,7 +51,6 @@ pub struct ClosedLoop {
     next_event: usize,
     heartbeat_every: u32,
     steps: u64,
-    last_outputs: Outputs,
 }
 
 /// Why a closed loop could not be built.
@@ -93,7 +101,6 @@ impl ClosedLoop {
             next_event: 0,
             heartbeat_every,
             steps: 0,
-            last_outputs: Outputs::DISABLED,
         })
     }
 
@@ -130,6 +137,18 @@ impl ClosedLoop {
     /// One PWM period with the measurements passed through `tamper` first (fault injection:
     /// an open pressure wire, an encoder jump, an over-current reading).
     pub fn step_with(&mut self, tamper: impl FnOnce(Measurements) -> Measurements) -> Sample {
+        self.period(tamper, record)
+    }
+
+    /// One PWM period: scenario commands due now, sample, control, then `record` (given the
+    /// plant still at the sampling instant, the controller after its ISR and the outputs),
+    /// then integrate. Recording is a closure so that unlogged periods pay nothing for the
+    /// plant's observables or the telemetry frame.
+    fn period<R>(
+        &mut self,
+        tamper: impl FnOnce(Measurements) -> Measurements,
+        record: impl FnOnce(&Plant, &Controller, Outputs) -> R,
+    ) -> R {
         let t = self.time_s();
         while let Some(ev) = self.scenario.events.get(self.next_event) {
             match ev {
@@ -156,30 +175,26 @@ impl ClosedLoop {
             encoder_count: r.encoder_count,
             encoder_index: r.encoder_index,
         });
-        let truth = self.plant.observe();
         let out = self.controller.on_current_sample(&m);
-        let telemetry = self.controller.telemetry();
+        let recorded = record(&self.plant, &self.controller, out);
         let d = out.duties;
         self.plant.advance(
             self.period_s,
             &Inputs::duties([d[0] as f64, d[1] as f64, d[2] as f64], out.pwm_enabled),
         );
-        self.last_outputs = out;
         self.steps += 1;
-        Sample {
-            telemetry,
-            truth,
-            outputs: out,
-        }
+        recorded
     }
 
     /// Runs until `t_end` seconds, calling `each` every `every` periods.
     pub fn run(&mut self, t_end_s: f64, every: u32, mut each: impl FnMut(&Sample)) {
         let n = libm::ceil((t_end_s - self.time_s()) / self.period_s).max(0.0) as u64;
         for k in 0..n {
-            let s = self.step();
             if k % every.max(1) as u64 == 0 {
+                let s = self.period(|m| m, record);
                 each(&s);
+            } else {
+                self.period(|m| m, |_, _, _| ());
             }
         }
     }
