@@ -7,8 +7,9 @@
 //! written, a feature not built yet); the message goes to standard error. Nothing panics.
 //!
 //! Subcommands are routed in [`run`]; `rig` and `accumulator-design` are implemented here,
-//! the closed-loop ones in [`crate::simulate`], the others in [`crate::pending`] until their
-//! issues land.
+//! the closed-loop ones in [`crate::simulate`], `ingest` in [`crate::ingest`], `commission`
+//! and `tune` in [`crate::commission`] and [`crate::tune`], `diagnose` in
+//! [`crate::diagnose::command`].
 
 use crate::bench_log::BenchLogError;
 use crate::rig_file::{self, RigFileError};
@@ -277,10 +278,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Demo(a) => crate::simulate::run_demo(&rig, a),
         Command::Simulate(a) => crate::simulate::run_simulate(&rig, a),
         Command::SweepPrecharge(a) => crate::simulate::run_sweep_precharge(&rig, a),
-        Command::Commission(a) => crate::pending::run_commission(&rig, a),
-        Command::Tune(a) => crate::pending::run_tune(&rig, a),
+        Command::Commission(a) => crate::commission::run_commission(&rig, a),
+        Command::Tune(a) => crate::tune::run_tune(&rig, a),
         Command::Ingest(a) => crate::ingest::run_ingest(a),
-        Command::Diagnose(a) => crate::pending::run_diagnose(&rig, a),
+        Command::Diagnose(a) => crate::diagnose::command::run_diagnose(&rig, a),
     }
 }
 

@@ -9,18 +9,21 @@
 //! - [`study`]: the paper's accumulator study (Section 4.3).
 //! - [`simulate`]: the closed-loop runs behind `demo`, `simulate` and `sweep-precharge`.
 //! - [`ingest`]: the firmware's defmt telemetry (decoded text) to a bench log.
-//! - [`pending`]: the subcommands of other issues, routed but not built yet.
+//! - [`commission`], [`tune`]: commissioning on the simulated motor and loop tuning from a
+//!   step log (issue 8).
+//! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain (issue 5).
 //! - [`atomic_file`]: output files appear whole or not at all.
 
 pub mod atomic_file;
 pub mod bench_log;
 pub mod cli;
+pub mod commission;
 pub mod diagnose;
 pub mod ingest;
-pub mod pending;
 pub mod plots;
 pub mod pulsation;
 pub mod rig_file;
 pub mod run;
 pub mod simulate;
 pub mod study;
+pub mod tune;

@@ -9,6 +9,7 @@
 //!
 //! The CLI command stays routed to its placeholder until the analysis is built on this.
 
+pub mod command;
 pub mod replay;
 
 pub use replay::{replay_hydraulics, replay_motor, Replay, ReplayError, ReplayKind};
