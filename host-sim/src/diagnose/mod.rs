@@ -10,9 +10,35 @@
 //! The CLI command stays routed to its placeholder until the analysis is built on this.
 
 pub mod command;
+pub mod diagnosis;
 pub mod replay;
 
+pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
+
 pub use replay::{replay_hydraulics, replay_motor, Replay, ReplayError, ReplayKind};
+
+use crate::bench_log::BenchLog;
+use plant_model::Rig;
+
+/// Why a log could not be diagnosed.
+#[derive(Debug, thiserror::Error)]
+pub enum DiagnoseError {
+    /// The log or the rig cannot be replayed.
+    #[error(transparent)]
+    Replay(#[from] ReplayError),
+    /// The log holds nothing the diagnosis can use.
+    #[error("{0}")]
+    Unusable(String),
+}
+
+/// Diagnoses `log` against the nominal model `rig`: replays, residual analysis, candidate
+/// ranking, fit on the identification segment, score on the validation segment.
+pub fn diagnose(log: &BenchLog, rig: &Rig) -> Result<Diagnosis, DiagnoseError> {
+    let _ = (log, rig);
+    Err(DiagnoseError::Unusable(
+        "diagnosis not built yet (issue 5)".into(),
+    ))
+}
 
 /// Goodness of fit in percent, 100·(1 − ‖y − ŷ‖₂ / ‖y − mean(y)‖₂), of `simulated` (ŷ)
 /// against `measured` (y): 100 is a perfect match, 0 is no better than the measured mean,

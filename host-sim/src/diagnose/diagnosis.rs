@@ -1,0 +1,74 @@
+//! What `eha diagnose` finds, in the shape of the contract's JSON
+//! (`shared/contracts/eha-cli.md`): the segments, the baseline and extended fits on the
+//! validation segment, the ranked causes with their fitted parameters and evidence, and the
+//! gain.
+
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// The diagnosis of one bench log.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Diagnosis {
+    /// Data rows of the log.
+    pub samples: usize,
+    /// Where the candidates' parameters were fitted. [s]
+    pub identification_segment_s: [f64; 2],
+    /// Where both models are scored; the fit never saw it. [s]
+    pub validation_segment_s: [f64; 2],
+    /// The nominal model (the rig file) on the validation segment.
+    pub baseline: Fit,
+    /// Candidate effects, most likely first; `none` leads when the nominal model explains
+    /// the log within its noise.
+    pub causes: Vec<Cause>,
+    /// The model extended by the kept effects (the nominal one when none is kept), on the
+    /// validation segment.
+    pub extended: Extended,
+    /// Extended minus baseline.
+    pub gain: Gain,
+}
+
+/// Goodness of fit of one model on the validation segment.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Fit {
+    /// Fit of the pressure `p_pa`, 100·(1 − ‖y − ŷ‖/‖y − ȳ‖). [%]
+    pub fit_percent: f64,
+    /// Root-mean-square pressure error. [Pa]
+    pub rmse_pa: f64,
+    /// The same fit measure for each logged signal the model predicts. [%]
+    pub fit_percent_by_signal: BTreeMap<String, f64>,
+}
+
+/// One candidate cause.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Cause {
+    /// Effect name from `shared/contracts/effects.md`.
+    pub effect: String,
+    /// Evidence score: higher is more likely. [1]
+    pub score: f64,
+    /// Fitted parameters, by the catalogue's parameter names (SI).
+    pub parameters: BTreeMap<String, f64>,
+    /// One line saying why.
+    pub evidence: String,
+}
+
+/// The extended model's fit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Extended {
+    /// Effects switched on (empty when none was kept).
+    pub effects: Vec<String>,
+    /// Fit of `p_pa`. [%]
+    pub fit_percent: f64,
+    /// Root-mean-square pressure error. [Pa]
+    pub rmse_pa: f64,
+    /// Fit per signal. [%]
+    pub fit_percent_by_signal: BTreeMap<String, f64>,
+}
+
+/// What the extension gained on the validation segment.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Gain {
+    /// Extended minus baseline pressure fit. [percentage points]
+    pub fit_points: f64,
+    /// 100·(1 − rmse_ext / rmse_base). [%]
+    pub rmse_reduction_percent: f64,
+}
