@@ -7,6 +7,7 @@
 //! apart from controller state: [`crate::Controller::new`] derives its discrete-time
 //! constants from a validated `Config` and never mutates it.
 
+pub use crate::commissioning::CommissioningConfig;
 use core::fmt;
 
 /// Sample rates of the three loops.
@@ -200,6 +201,8 @@ pub struct Config {
     pub limits: FaultLimits,
     /// Calibration.
     pub calibration: CalibrationConfig,
+    /// Commissioning sequence (motor identification, issue 8).
+    pub commissioning: CommissioningConfig,
 }
 
 /// A configuration field that failed validation.
@@ -329,6 +332,7 @@ impl Config {
                 alignment_current_a: 5.0,
                 alignment_time_s: 0.5,
             },
+            commissioning: CommissioningConfig::nominal(),
         }
     }
 
@@ -540,7 +544,12 @@ impl Config {
         if k.alignment_time_s > 60.0 {
             return Err(err("calibration.alignment_time_s", "must be at most 60 s"));
         }
-        Ok(())
+        self.commissioning.validate(
+            l.over_current_a,
+            c.voltage_limit_v,
+            sp.speed_limit_rad_s,
+            r.pwm_hz,
+        )
     }
 }
 
