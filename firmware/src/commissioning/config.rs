@@ -75,83 +75,133 @@ impl CommissioningConfig {
         speed_limit_rad_s: f32,
         pwm_hz: f32,
     ) -> Result<(), ConfigError> {
-        let err = |field, problem| Err(ConfigError { field, problem });
-        let finite_positive = |v: f32| v.is_finite() && v > 0.0;
-        if !finite_positive(self.current_a) || self.current_a >= 0.8 * over_current_a {
-            return err(
-                "commissioning.current_a",
-                "must be > 0 and below 0.8 * limits.over_current_a",
-            );
-        }
-        let samples = |t: f32| t.is_finite() && t * pwm_hz >= 16.0 && t <= 10.0;
-        for (field, t) in [
-            ("commissioning.settle_time_s", self.settle_time_s),
-            ("commissioning.average_time_s", self.average_time_s),
-            ("commissioning.sweep_time_s", self.sweep_time_s),
-            ("commissioning.step_timeout_s", self.step_timeout_s),
-        ] {
-            if !samples(t) {
-                return err(field, "must cover at least 16 PWM periods and at most 10 s");
-            }
-        }
-        // The open-phase check runs in the sweep's first 10 ms.
-        if self.sweep_time_s < 0.02 {
-            return err("commissioning.sweep_time_s", "must be at least 0.02 s");
-        }
-        if !(self.alignment_damping_a_per_rad_s.is_finite()
-            && self.alignment_damping_a_per_rad_s >= 0.0)
-        {
-            return err(
-                "commissioning.alignment_damping_a_per_rad_s",
-                "must be finite and >= 0",
-            );
-        }
-        if !finite_positive(self.pulse_voltage_v) || self.pulse_voltage_v > 0.5 * voltage_limit_v {
-            return err(
-                "commissioning.pulse_voltage_v",
-                "must be > 0 and at most 0.5 * current.voltage_limit_v",
-            );
-        }
-        if !(1..=10_000).contains(&self.pulse_cycles) {
-            return err("commissioning.pulse_cycles", "must be within 1..=10000");
-        }
-        if !finite_positive(self.spin_speed_rad_s) || self.spin_speed_rad_s > speed_limit_rad_s {
-            return err(
-                "commissioning.spin_speed_rad_s",
-                "must be > 0 and at most speed.speed_limit_rad_s",
-            );
-        }
-        if !finite_positive(self.spin_current_a) || self.spin_current_a > self.current_a {
-            return err(
-                "commissioning.spin_current_a",
-                "must be > 0 and at most commissioning.current_a",
-            );
-        }
+        let pos = |v: f32| v.is_finite() && v > 0.0;
+        let time = |t: f32| t.is_finite() && t * pwm_hz >= 16.0 && t <= 10.0;
+        const TIME: &str = "must cover at least 16 PWM periods and at most 10 s";
         // A tenth of the sampling rate keeps the sample delay's phase loss below 27°.
         let w_max = 0.1 * core::f32::consts::TAU * pwm_hz;
-        if !finite_positive(self.current_bandwidth_rad_s) || self.current_bandwidth_rad_s > w_max {
-            return err(
+        // One table, checked in order (compact on the target: one loop, no branch per
+        // field).
+        let checks: [(&'static str, bool, &'static str); 14] = [
+            (
+                "commissioning.current_a",
+                pos(self.current_a) && self.current_a < 0.8 * over_current_a,
+                "must be > 0 and below 0.8 * limits.over_current_a",
+            ),
+            (
+                "commissioning.settle_time_s",
+                time(self.settle_time_s),
+                TIME,
+            ),
+            (
+                "commissioning.average_time_s",
+                time(self.average_time_s),
+                TIME,
+            ),
+            // The open-phase check runs in the sweep's first 10 ms.
+            (
+                "commissioning.sweep_time_s",
+                time(self.sweep_time_s) && self.sweep_time_s >= 0.02,
+                "must be within 0.02 s..=10 s",
+            ),
+            (
+                "commissioning.step_timeout_s",
+                time(self.step_timeout_s),
+                TIME,
+            ),
+            (
+                "commissioning.alignment_damping_a_per_rad_s",
+                self.alignment_damping_a_per_rad_s.is_finite()
+                    && self.alignment_damping_a_per_rad_s >= 0.0,
+                "must be finite and >= 0",
+            ),
+            (
+                "commissioning.pulse_voltage_v",
+                pos(self.pulse_voltage_v) && self.pulse_voltage_v <= 0.5 * voltage_limit_v,
+                "must be > 0 and at most 0.5 * current.voltage_limit_v",
+            ),
+            (
+                "commissioning.pulse_cycles",
+                (1..=10_000).contains(&self.pulse_cycles),
+                "must be within 1..=10000",
+            ),
+            (
+                "commissioning.spin_speed_rad_s",
+                pos(self.spin_speed_rad_s) && self.spin_speed_rad_s <= speed_limit_rad_s,
+                "must be > 0 and at most speed.speed_limit_rad_s",
+            ),
+            (
+                "commissioning.spin_current_a",
+                pos(self.spin_current_a) && self.spin_current_a <= self.current_a,
+                "must be > 0 and at most commissioning.current_a",
+            ),
+            (
                 "commissioning.current_bandwidth_rad_s",
+                pos(self.current_bandwidth_rad_s) && self.current_bandwidth_rad_s <= w_max,
                 "must be > 0 and at most 0.1 * 2π * rates.pwm_hz",
-            );
-        }
-        if !finite_positive(self.speed_natural_frequency_rad_s)
-            || self.speed_natural_frequency_rad_s > 0.25 * self.current_bandwidth_rad_s
-        {
-            return err(
+            ),
+            (
                 "commissioning.speed_natural_frequency_rad_s",
+                pos(self.speed_natural_frequency_rad_s)
+                    && self.speed_natural_frequency_rad_s <= 0.25 * self.current_bandwidth_rad_s,
                 "must be > 0 and at most 0.25 * commissioning.current_bandwidth_rad_s",
-            );
-        }
-        if !finite_positive(self.speed_damping_ratio) {
-            return err(
+            ),
+            (
                 "commissioning.speed_damping_ratio",
+                pos(self.speed_damping_ratio),
                 "must be finite and > 0",
-            );
-        }
-        if !(self.plausible_ratio.is_finite() && self.plausible_ratio > 1.0) {
-            return err("commissioning.plausible_ratio", "must be finite and > 1");
+            ),
+            (
+                "commissioning.plausible_ratio",
+                self.plausible_ratio.is_finite() && self.plausible_ratio > 1.0,
+                "must be finite and > 1",
+            ),
+        ];
+        for (field, good, problem) in checks {
+            if !good {
+                return Err(ConfigError { field, problem });
+            }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::Config;
+
+    #[test]
+    fn nominal_is_valid_and_bad_fields_are_named() {
+        assert_eq!(Config::nominal().validate(), Ok(()));
+        type Case = (fn(&mut Config), &'static str);
+        let cases: [Case; 5] = [
+            // 0.8 × the 45 A over-current trip is 36 A.
+            (
+                |c| c.commissioning.current_a = 40.0,
+                "commissioning.current_a",
+            ),
+            (
+                |c| c.commissioning.sweep_time_s = 0.01,
+                "commissioning.sweep_time_s",
+            ),
+            // 0.1 × 2π × 20 kHz = 12 566 rad/s.
+            (
+                |c| c.commissioning.current_bandwidth_rad_s = 13_000.0,
+                "commissioning.current_bandwidth_rad_s",
+            ),
+            (
+                |c| c.commissioning.spin_speed_rad_s = 250.0,
+                "commissioning.spin_speed_rad_s",
+            ),
+            (
+                |c| c.commissioning.plausible_ratio = f32::NAN,
+                "commissioning.plausible_ratio",
+            ),
+        ];
+        for (mutate, field) in cases {
+            let mut c = Config::nominal();
+            mutate(&mut c);
+            assert_eq!(c.validate().map_err(|e| e.field), Err(field));
+        }
     }
 }

@@ -39,7 +39,6 @@ pub struct CircularMean {
 
 impl CircularMean {
     /// Adds one angle. [rad]
-    #[inline]
     pub fn add(&mut self, theta: f32) {
         let sc = sin_cos(theta);
         self.sin += sc.sin;

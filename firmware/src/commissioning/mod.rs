@@ -229,6 +229,7 @@ pub struct Commissioning {
 
 impl Commissioning {
     /// From a validated configuration; idle until [`Commissioning::start`].
+    #[inline(never)]
     pub fn new(cfg: &Config) -> Commissioning {
         let pwm = cfg.rates.pwm_hz.max(1.0);
         let c = cfg.commissioning;
@@ -605,6 +606,7 @@ impl Commissioning {
     }
 
     /// d-q currents in the encoder's frame with the identified offset. [A]
+    #[inline(never)]
     fn encoder_dq(&self, x: &Input) -> Dq {
         let [a, b, c] = x.i_abc;
         park(clarke(a, b, c), sin_cos(x.theta_e_raw - self.offset))

@@ -26,7 +26,9 @@ impl Controller {
         }
     }
 
-    /// One commissioning period: (bridge on, electrical angle, fault found).
+    /// One commissioning period: (bridge on, electrical angle, fault found). Kept out of
+    /// the ISR body's inlined code: it runs only while commissioning.
+    #[inline(never)]
     pub(super) fn commission_step(&mut self, m: &Measurements) -> (bool, f32, Option<FaultCode>) {
         let input = Input {
             i_abc: self.current.phase_currents(m),
