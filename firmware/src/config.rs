@@ -573,7 +573,29 @@ mod tests {
     #[test]
     fn each_bad_field_is_named() {
         type Case = (fn(&mut Config), &'static str);
-        let cases: [Case; 14] = [
+        let cases: [Case; 19] = [
+            // 0.8 × the 45 A over-current trip is 36 A.
+            (
+                |c| c.commissioning.current_a = 40.0,
+                "commissioning.current_a",
+            ),
+            (
+                |c| c.commissioning.sweep_time_s = 0.01,
+                "commissioning.sweep_time_s",
+            ),
+            // 0.1 × 2π × 20 kHz = 12 566 rad/s.
+            (
+                |c| c.commissioning.current_bandwidth_rad_s = 13_000.0,
+                "commissioning.current_bandwidth_rad_s",
+            ),
+            (
+                |c| c.commissioning.spin_speed_rad_s = 250.0,
+                "commissioning.spin_speed_rad_s",
+            ),
+            (
+                |c| c.commissioning.plausible_ratio = f32::NAN,
+                "commissioning.plausible_ratio",
+            ),
             (|c| c.rates.pwm_hz = 0.0, "rates.pwm_hz"),
             (|c| c.rates.pwm_hz = 200e3, "rates.pwm_hz"),
             (|c| c.rates.speed_loop_hz = 3_000.0, "rates.speed_loop_hz"),
