@@ -35,6 +35,14 @@
 //!
 //! Any identified value outside [nameplate / r, nameplate · r] (`plausible_ratio`) or not
 //! finite is fault 14.
+//!
+//! Accuracy on the plant model with noise and quantisation (`tests/tests/commissioning.rs`,
+//! 20 rigs with R_s, L_d, L_q, ψ_f off by up to ±30 %): R_s, L_d, ψ_f within 0.1 %, L_q
+//! biased low by up to 1.1 % (the back-EMF of the rotor's small motion under the q pulses,
+//! see [`CommissioningConfig::pulse_voltage_v`]), the offset within 0.2° electrical, J
+//! about +1.5 %. Known limit: with inverter dead time the spin's small q-current sits in
+//! the dead-time band, whose voltage error reads as extra back-EMF (ψ_f +1.6 % at 1 µs)
+//! and as torque error in J (+8 %); R_s and the inductances are unaffected.
 
 pub mod config;
 pub mod estimate;
