@@ -12,6 +12,7 @@
 #![no_std]
 #![deny(missing_docs)]
 
+pub mod commissioning;
 pub mod config;
 pub mod scenario;
 

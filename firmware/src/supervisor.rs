@@ -80,11 +80,19 @@ pub enum FaultCode {
     Watchdog = 11,
     /// Calibrated current offsets out of range. (12)
     CurrentOffset = 12,
+    /// Commissioning: a current step not reached (open phase, disconnected motor). (13)
+    CommissioningCurrent = 13,
+    /// Commissioning: an identified value not finite or outside the plausible window
+    /// around the nameplate. (14)
+    CommissioningImplausible = 14,
+    /// Commissioning: the encoder moved backwards (reversed), not at all, or the shaft did
+    /// not follow the current vector. (15)
+    CommissioningEncoder = 15,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 12] = [
+    pub const ALL: [FaultCode; 15] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -97,9 +105,12 @@ impl FaultCode {
         FaultCode::CommandTimeout,
         FaultCode::Watchdog,
         FaultCode::CurrentOffset,
+        FaultCode::CommissioningCurrent,
+        FaultCode::CommissioningImplausible,
+        FaultCode::CommissioningEncoder,
     ];
 
-    /// Telemetry code (1..=12).
+    /// Telemetry code (1..=15).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -123,6 +134,9 @@ impl FaultCode {
                 | FaultCode::CommandTimeout
                 | FaultCode::Watchdog
                 | FaultCode::CurrentOffset
+                | FaultCode::CommissioningCurrent
+                | FaultCode::CommissioningImplausible
+                | FaultCode::CommissioningEncoder
         )
     }
 }
@@ -142,6 +156,11 @@ impl fmt::Display for FaultCode {
             FaultCode::CommandTimeout => "command timeout",
             FaultCode::Watchdog => "watchdog (control-loop overrun)",
             FaultCode::CurrentOffset => "current offset out of range",
+            FaultCode::CommissioningCurrent => "commissioning: current not reached (open phase?)",
+            FaultCode::CommissioningImplausible => "commissioning: implausible identified value",
+            FaultCode::CommissioningEncoder => {
+                "commissioning: encoder reversed or shaft not moving"
+            }
         };
         write!(f, "fault {}: {}", self.code(), s)
     }
