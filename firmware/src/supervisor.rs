@@ -80,11 +80,14 @@ pub enum FaultCode {
     Watchdog = 11,
     /// Calibrated current offsets out of range. (12)
     CurrentOffset = 12,
+    /// The stored parameter table was corrupt, of another version or inconsistent: the
+    /// defaults were loaded instead (codes 13–15 belong to commissioning). (16)
+    ParameterStoreInvalid = 16,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 12] = [
+    pub const ALL: [FaultCode; 13] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -97,9 +100,10 @@ impl FaultCode {
         FaultCode::CommandTimeout,
         FaultCode::Watchdog,
         FaultCode::CurrentOffset,
+        FaultCode::ParameterStoreInvalid,
     ];
 
-    /// Telemetry code (1..=12).
+    /// Telemetry code (1..=12, 16; 13–15 are left to the commissioning faults).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -123,6 +127,7 @@ impl FaultCode {
                 | FaultCode::CommandTimeout
                 | FaultCode::Watchdog
                 | FaultCode::CurrentOffset
+                | FaultCode::ParameterStoreInvalid
         )
     }
 }
@@ -142,6 +147,7 @@ impl fmt::Display for FaultCode {
             FaultCode::CommandTimeout => "command timeout",
             FaultCode::Watchdog => "watchdog (control-loop overrun)",
             FaultCode::CurrentOffset => "current offset out of range",
+            FaultCode::ParameterStoreInvalid => "stored parameters invalid, defaults loaded",
         };
         write!(f, "fault {}: {}", self.code(), s)
     }
@@ -294,6 +300,11 @@ mod tests {
             seen |= f.bit();
         }
         assert_eq!(FaultCode::from_code(0), None);
+        // Code 16 is the documented parameter-store fault.
+        assert_eq!(
+            FaultCode::from_code(16),
+            Some(FaultCode::ParameterStoreInvalid)
+        );
         for m in [
             Mode::Disabled,
             Mode::Calibrating,
