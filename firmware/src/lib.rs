@@ -18,6 +18,7 @@ pub mod controller;
 pub mod current_loop;
 pub mod encoder;
 pub mod io;
+pub mod param_store;
 pub mod parameters;
 pub mod pi;
 pub mod pressure_loop;

@@ -13,8 +13,9 @@
 //!
 //! Ids are grouped by tens (current loop 1–5, speed loop 10–15, pressure loop 20–25,
 //! hydraulics 30–36, telemetry 40, commissioning results 50–54); an id is never reused for
-//! another meaning. The stored table carries a fingerprint of this list, so a firmware
-//! with a changed table never loads an old record as if it matched.
+//! another meaning. The stored table ([`crate::param_store`]) carries a fingerprint of this
+//! list ([`layout_fingerprint`]), so a firmware with a changed table never loads an old
+//! record as if it matched.
 //!
 //! # Parameter table
 //!
@@ -488,6 +489,17 @@ pub fn apply_all(cfg: &mut Config, values: &[f32; COUNT]) -> Result<(), ParamErr
     })?;
     *cfg = next;
     Ok(())
+}
+
+/// CRC-32 of the table's ids and names in order: changes whenever a parameter is added,
+/// removed, renumbered or renamed, so a stored record of another table is recognised.
+pub fn layout_fingerprint() -> u32 {
+    let mut digest = crate::param_store::CRC.digest();
+    for p in ParamId::ALL {
+        digest.update(&[p.code()]);
+        digest.update(p.name().as_bytes());
+    }
+    digest.finalize()
 }
 
 #[cfg(test)]
