@@ -5,15 +5,18 @@
 //! meet it. Identified values are checked against the rigs' own numbers and the paper's gas
 //! law, computed here by hand.
 
+mod common;
+
+use common::{eha, s};
 use host_sim::bench_log::{self, BenchLog};
 use host_sim::cli::LoopKind;
 use host_sim::rig_file;
 use host_sim::run::{run, RunOptions};
-use host_sim::tune::{self, predict, Identified, PRESSURE_TARGET, SPEED_TARGET};
+use host_sim::tune::step::Target;
+use host_sim::tune::{self, predict, Identified, Tuning, PRESSURE_TARGET, SPEED_TARGET};
 use plant_model::Rig;
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
 
 /// A log of `scenario` on `plant` with the controller configured from `controller`.
 fn log_of(plant: &Rig, controller: &Rig, scenario: &str) -> BenchLog {
@@ -32,6 +35,24 @@ fn log_of(plant: &Rig, controller: &Rig, scenario: &str) -> BenchLog {
     )
     .expect("the run succeeds")
     .log
+}
+
+/// Tunes `kind` from a `scenario` log of `truth` under the nominal rig's controller;
+/// checks that the old gains miss `target` in the log and that the proposed ones, replayed
+/// on `truth` itself (another noise seed), meet it.
+fn retuned(truth: &Rig, scenario: &str, kind: LoopKind, target: Target) -> Tuning {
+    let belief = Rig::nominal();
+    let log = log_of(truth, &belief, scenario);
+    let t = tune::tune(&belief, &log, kind, target).unwrap();
+    assert!(!t.measured.meets(&target), "old gains: {:?}", t.measured);
+    let replay = predict::simulate(truth, &t.proposed_config, &t.spec, 7).unwrap();
+    assert!(
+        replay.metrics.meets(&target),
+        "proposed on the true plant: {:?} (predicted {:?})",
+        replay.metrics,
+        t.predicted
+    );
+    t
 }
 
 fn precharged(p0: f64) -> Rig {
@@ -64,15 +85,8 @@ fn hand_capacitance(rig: &Rig, p: f64) -> f64 {
 fn pressure_loop_retuned_for_a_10_mpa_precharge_meets_the_target_on_the_true_plant() {
     let truth = precharged(10e6);
     let belief = Rig::nominal();
-    let log = log_of(&truth, &belief, "pressure-step");
-    let t = tune::tune(&belief, &log, LoopKind::Pressure, PRESSURE_TARGET).unwrap();
-
     // The old schedule, sized for an absorber that takes no oil below 10 MPa, limit-cycles.
-    assert!(
-        !t.measured.meets(&PRESSURE_TARGET),
-        "old gains: {:?}",
-        t.measured
-    );
+    let t = retuned(&truth, "pressure-step", LoopKind::Pressure, PRESSURE_TARGET);
 
     // Identified: oil only (the absorber never reached), against the rig's V/β; the
     // schedule's assumption at 5 MPa is the paper's C(p) with 3 MPa, some sixty times more.
@@ -104,19 +118,12 @@ fn pressure_loop_retuned_for_a_10_mpa_precharge_meets_the_target_on_the_true_pla
         high.precharge_pa
     );
 
-    // The proposal on the true plant (10 MPa), not on the identified model.
-    let replay = predict::simulate(&truth, &t.proposed_config, &t.spec, 7).unwrap();
-    assert!(
-        replay.metrics.meets(&PRESSURE_TARGET),
-        "proposed on the true plant: {:?} (predicted {:?})",
-        replay.metrics,
-        t.predicted
-    );
     // The equivalent gain at 5 MPa falls by the capacitance ratio (Kp = ω_c·C/K_q).
     let fall = t.current_gains.kp / t.proposed_gains.kp;
-    let bw = t.current_config.pressure.bandwidth_rad_s / t.proposed_config.pressure.bandwidth_rad_s;
+    let (old, new) = (t.current_config.pressure, t.proposed_config.pressure);
+    let bw = (old.bandwidth_rad_s / new.bandwidth_rad_s) as f64;
     assert!(
-        (fall / bw as f64 / ratio - 1.0).abs() < 0.1,
+        (fall / bw / ratio - 1.0).abs() < 0.1,
         "kp fell {fall}× with bandwidth ratio {bw}, capacitance ratio {ratio}"
     );
 }
@@ -124,16 +131,8 @@ fn pressure_loop_retuned_for_a_10_mpa_precharge_meets_the_target_on_the_true_pla
 #[test]
 fn speed_loop_retuned_for_three_times_the_inertia_meets_the_target_on_the_true_plant() {
     let truth = heavy_shaft(3.0);
-    let belief = Rig::nominal();
-    let log = log_of(&truth, &belief, "speed-step");
-    let t = tune::tune(&belief, &log, LoopKind::Speed, SPEED_TARGET).unwrap();
-
     // Table 1's gains on 3·J: ζ falls by √3, the step overshoots beyond the target.
-    assert!(
-        !t.measured.meets(&SPEED_TARGET),
-        "old gains: {:?}",
-        t.measured
-    );
+    let t = retuned(&truth, "speed-step", LoopKind::Speed, SPEED_TARGET);
 
     let Identified::Speed { shaft, .. } = t.identified else {
         panic!("speed identification expected");
@@ -145,13 +144,6 @@ fn speed_loop_retuned_for_three_times_the_inertia_meets_the_target_on_the_true_p
         shaft.inertia_kg_m2
     );
 
-    let replay = predict::simulate(&truth, &t.proposed_config, &t.spec, 7).unwrap();
-    assert!(
-        replay.metrics.meets(&SPEED_TARGET),
-        "proposed on the true plant: {:?} (predicted {:?})",
-        replay.metrics,
-        t.predicted
-    );
     // Ki = ω²·J/K_t: at least the design's ω on three times J needs about three times Ki.
     assert!(
         t.proposed_gains.ki > 2.0 * t.current_gains.ki,
@@ -162,22 +154,8 @@ fn speed_loop_retuned_for_three_times_the_inertia_meets_the_target_on_the_true_p
 
 // ---------------------------------------------------------------- the command line
 
-fn eha(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eha"))
-        .args(args)
-        .output()
-        .expect("the eha binary runs")
-}
-
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("tune-{name}"));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::scratch("tune", name)
 }
 
 #[test]
