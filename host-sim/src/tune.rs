@@ -93,6 +93,8 @@ pub struct Tuning {
     pub loop_kind: LoopKind,
     /// The step found in the log.
     pub step: Step,
+    /// When the step's reference left its initial value in the log. [s]
+    pub step_time_s: f64,
     /// Its replay (setpoints and windows) used for the predictions.
     pub spec: StepSpec,
     /// The target.
@@ -185,7 +187,17 @@ pub fn tune(
         target,
     };
     let t = match kind {
-        LoopKind::Speed => tune_speed(&job)?,
+        LoopKind::Speed => {
+            let rise = speed::rise_samples(log, &step);
+            if rise < speed::MIN_RISE_SAMPLES {
+                notes.push(format!(
+                    "the speed rose from 10 % to 90 % of the step in {rise} log samples: too few \
+                     to resolve the acceleration, so the identified inertia is uncertain (log \
+                     faster, or step smaller)"
+                ));
+            }
+            tune_speed(&job)?
+        }
         LoopKind::Pressure => {
             let limit = config.speed.speed_limit_rad_s as f64;
             let at_limit = pressure::longest_at_speed_limit(log, &step, limit);
@@ -242,6 +254,7 @@ pub fn tune(
     Ok(Tuning {
         loop_kind: kind,
         step,
+        step_time_s: log.t_s[step.start],
         spec,
         target,
         identified,
@@ -410,7 +423,7 @@ impl Tuning {
             .collect();
         json!({
             "loop": loop_name(self.loop_kind),
-            "step": {"from": self.step.from, "to": self.step.to, "t_s": self.spec.lead_s},
+            "step": {"from": self.step.from, "to": self.step.to, "t_s": self.step_time_s},
             "target": {
                 "overshoot_percent": self.target.overshoot_percent,
                 "settling_s": self.target.settling_s,
@@ -436,10 +449,11 @@ impl Tuning {
         };
         let _ = writeln!(
             s,
-            "{} loop: step {:.2} → {:.2} {unit}",
+            "{} loop: step {:.2} → {:.2} {unit} at {:.3} s",
             loop_name(self.loop_kind),
             self.step.from * scale,
-            self.step.to * scale
+            self.step.to * scale,
+            self.step_time_s
         );
         match &self.identified {
             Identified::Speed {

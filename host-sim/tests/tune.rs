@@ -46,6 +46,11 @@ fn retuned(truth: &Rig, scenario: &str, kind: LoopKind, target: Target) -> Tunin
     let t = tune::tune(&belief, &log, kind, target).unwrap();
     assert!(!t.measured.meets(&target), "old gains: {:?}", t.measured);
     let replay = predict::simulate(truth, &t.proposed_config, &t.spec, 7).unwrap();
+    // The before/after figures (`--nocapture` shows them).
+    eprintln!(
+        "{scenario}: measured {:?}; proposed {:?} predicted {:?}, on the true plant {:?}",
+        t.measured, t.proposed_gains, t.predicted, replay.metrics
+    );
     assert!(
         replay.metrics.meets(&target),
         "proposed on the true plant: {:?} (predicted {:?})",

@@ -111,6 +111,23 @@ pub fn identify(rig: &Rig, log: &BenchLog, step: &Step) -> Result<Shaft, String>
     Ok(shaft)
 }
 
+/// Samples of the log between the speed's 10 % and 90 % crossings of the step: the
+/// acceleration the inertia is identified from. A handful cannot resolve it (the torque
+/// integral of a sub-sample current pulse is not known).
+pub fn rise_samples(log: &BenchLog, step: &Step) -> usize {
+    let size = step.to - step.from;
+    let frac = |k: usize| (log.speed_rad_s[k] - step.from) / size;
+    let window = step.start..step.end;
+    let first = |level: f64| window.clone().find(|&k| frac(k) >= level);
+    match (first(0.1), first(0.9)) {
+        (Some(a), Some(b)) if b >= a => b - a,
+        _ => 0,
+    }
+}
+
+/// Samples of acceleration below which the identified inertia is flagged as uncertain.
+pub const MIN_RISE_SAMPLES: usize = 10;
+
 /// Natural frequency [rad/s] and damping ratio [1] of the speed loop `config` closes on a
 /// shaft of inertia `j` and viscous friction `b`, with torque constant `k_t`.
 pub fn poles(config: &Config, k_t: f64, j: f64, b: f64) -> (f64, f64) {
