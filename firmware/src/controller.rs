@@ -274,7 +274,7 @@ impl Controller {
     /// PWM periods per telemetry frame the application should log at now: 1 while a step
     /// test runs, else `rates.telemetry_decimation`.
     pub fn telemetry_decimation(&self) -> u32 {
-        if self.step.is_some() {
+        if self.step.is_some_and(|s| s.remaining > 0) {
             1
         } else {
             self.cfg.rates.telemetry_decimation
@@ -707,10 +707,11 @@ impl Controller {
         Ok(())
     }
 
-    /// Counts a running step test down; ends it when its time is up or its mode was left.
+    /// Counts a running step test down at the start of a period (this period is stepped
+    /// while any remain); ends it when its time is up or its mode was left.
     #[inline]
     fn advance_step(&mut self, step: ActiveStep, mode: Mode) {
-        if mode != step.target.mode() || step.remaining <= 1 {
+        if mode != step.target.mode() || step.remaining == 0 {
             self.end_step(step);
         } else {
             self.step = Some(ActiveStep {

@@ -13,6 +13,7 @@
 #![cfg_attr(not(test), no_std)]
 
 pub mod can_protocol;
+pub mod can_server;
 pub mod config;
 pub mod controller;
 pub mod current_loop;
