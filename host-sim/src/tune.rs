@@ -177,6 +177,16 @@ pub fn tune(
         LoopKind::Pressure => (Signal::Pressure, &log.p_ref_pa[..], &log.p_pa[..]),
     };
     let step = step::find(&log.t_s, reference, signal).map_err(|e| no_step(kind, e))?;
+    let limit = config.speed.speed_limit_rad_s as f64;
+    if signal == Signal::Speed && step.from.abs().max(step.to.abs()) >= 0.99 * limit {
+        // The pressure loop's output pinned at the limit holds too, but is no setpoint.
+        return Err(TuneError::BadLog(format!(
+            "no speed setpoint step in the log: its speed_ref_rad_s steps between {:.0} and \
+             {:.0} rad/s, at the {limit:.0} rad/s limit (a saturated pressure loop, not a \
+             speed setpoint)",
+            step.from, step.to
+        )));
+    }
     let measured = step::metrics(&log.t_s, response, &step, signal);
     let mut notes = Vec::new();
     let job = Job {
@@ -199,7 +209,6 @@ pub fn tune(
             tune_speed(&job)?
         }
         LoopKind::Pressure => {
-            let limit = config.speed.speed_limit_rad_s as f64;
             let at_limit = pressure::longest_at_speed_limit(log, &step, limit);
             if at_limit > 0.25 * target.settling_s {
                 notes.push(format!(

@@ -206,6 +206,11 @@ fn json_has_the_contracts_fields_and_the_can_commands_set_the_precharge() {
         s(&log),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The limit-cycling pressure loop's speed reference holds ±200 rad/s: no speed step.
+    let o = eha(&["tune", s(&log), "--loop", "speed"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("no speed setpoint step"), "{err}");
     let o = eha(&["tune", s(&log), "--loop", "pressure", "--json", "-"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON document");
