@@ -21,8 +21,22 @@
 //! | `0x140` | host → drive | `Heartbeat`    | 0   | —                                       |
 //! | `0x180` | drive → host | `Status`       | 8   | see below                               |
 //! | `0x190` | drive → host | `Reject`       | 8   | see below                               |
+//! | `0x1A0` | drive → host | `Parameter`    | 8   | see below                               |
+//! | `0x200` | host → drive | `SetParameter` | 5   | `u8` parameter id, `f32` value in the parameter's unit |
+//! | `0x210` | host → drive | `GetParameter` | 1   | `u8` parameter id                       |
+//! | `0x220` | host → drive | `SaveParameters` | 0 | — (allowed in Disabled only)            |
+//! | `0x230` | host → drive | `StepTest`     | 7   | `u8` loop (1 current, 2 speed, 3 pressure), `f32` amplitude [A, rad/s, Pa], `u16` duration [ms] |
 //!
 //! Mode codes: `0` disabled, `1` calibrating, `2` speed control, `3` pressure control.
+//!
+//! The configuration and test commands (`0x200`‥`0x230`) sit above the replies on purpose:
+//! set-points, mode changes and the drive's status win arbitration over them. Their ids
+//! `0x240`‥`0x270` are free for further configuration commands. Parameter ids, names,
+//! units and bounds are the table of [`crate::parameters`]; values are IEEE-754 `f32`
+//! (little endian) in SI units, so a value read back is bit-identical to the one set.
+//! `SetParameter` is answered with a `Parameter` frame echoing the value now in use,
+//! `GetParameter` with a `Parameter` frame, `SaveParameters` and `StepTest` with a
+//! status (their function code in byte 6).
 //!
 //! A command frame must have exactly the DLC in the table; remote (RTR) and extended
 //! (29-bit) frames are not part of the protocol (the application's acceptance filter
@@ -57,13 +71,31 @@
 //! | 2‥5   | `i32` | the bound that was violated, in the command's wire unit (Pa, mrad/s, mode code or DLC); `0` when the reason has no bound |
 //! | 6‥7   | —     | reserved, `0`                                                    |
 //!
+//! For the configuration and test functions (codes `0x20`‥`0x23`) with reasons `1`, `2`,
+//! `5` and `7`, bytes 2‥5 are the bound as an IEEE-754 `f32` in SI units (for `5` the mode
+//! code the command needs) (the parameter's unit; A, rad/s or Pa for a step
+//! amplitude, s for a step duration) and byte 6 is the parameter id (`0` when no parameter
+//! is concerned); for the others byte 6 is `0`.
+//!
 //! Reason codes: `1` value below the minimum, `2` value above the maximum, `3` wrong data
 //! length (bound = expected DLC), `4` unknown mode code (bound = highest mode code), `5`
 //! refused in the present state (bound = the code of the latched or present fault that
 //! blocks it, `0` for a mode change that must go through disabled), `6` unknown function
-//! (bound = `0`), `7` value not acceptable for another reason.
+//! (bound = `0`), `7` value not acceptable for another reason (for a parameter: not a
+//! number, not whole, or in conflict with another parameter; bound = `0`), `8` unknown
+//! parameter id or step-test loop code (bound = `0`, byte 6 = the offending code).
+//!
+//! # Parameter (`0x1A0 + node`, DLC 8)
+//!
+//! | bytes | type  | content                                                          |
+//! |-------|-------|------------------------------------------------------------------|
+//! | 0     | `u8`  | parameter id                                                     |
+//! | 1‥4   | `f32` | value in use, in the parameter's unit                            |
+//! | 5‥7   | —     | reserved, `0`                                                    |
 
 use crate::controller::{Command, CommandError};
+use crate::parameters::{ParamError, ParamId};
+use crate::step_test::{StepLoop, StepTestError};
 use crate::supervisor::{Mode, ModeRefusal};
 
 /// Highest mode code on the wire (the codes are the control core's [`Mode::code`]).
@@ -103,6 +135,16 @@ pub mod id {
     pub const STATUS: u16 = 0x180;
     /// `Reject` reply.
     pub const REJECT: u16 = 0x190;
+    /// `Parameter` reply.
+    pub const PARAMETER: u16 = 0x1A0;
+    /// `SetParameter` command.
+    pub const SET_PARAMETER: u16 = 0x200;
+    /// `GetParameter` command.
+    pub const GET_PARAMETER: u16 = 0x210;
+    /// `SaveParameters` command.
+    pub const SAVE_PARAMETERS: u16 = 0x220;
+    /// `StepTest` command.
+    pub const STEP_TEST: u16 = 0x230;
 }
 
 /// Mask selecting the node number of an identifier.
@@ -183,6 +225,14 @@ pub enum Function {
     ClearFaults,
     /// `Heartbeat`, code `0x14`.
     Heartbeat,
+    /// `SetParameter`, code `0x20`.
+    SetParameter,
+    /// `GetParameter`, code `0x21`.
+    GetParameter,
+    /// `SaveParameters`, code `0x22`.
+    SaveParameters,
+    /// `StepTest`, code `0x23`.
+    StepTest,
 }
 
 impl Function {
@@ -194,12 +244,16 @@ impl Function {
             Function::SetSpeed => id::SET_SPEED,
             Function::ClearFaults => id::CLEAR_FAULTS,
             Function::Heartbeat => id::HEARTBEAT,
+            Function::SetParameter => id::SET_PARAMETER,
+            Function::GetParameter => id::GET_PARAMETER,
+            Function::SaveParameters => id::SAVE_PARAMETERS,
+            Function::StepTest => id::STEP_TEST,
         }
     }
 
     /// Function code carried in status and reject frames (identifier base >> 4).
     pub fn code(self) -> u8 {
-        // Bases are at most 0x140, so the shifted value fits a byte.
+        // Bases are at most 0x230, so the shifted value fits a byte.
         (self.id_base() >> 4) as u8
     }
 
@@ -215,6 +269,10 @@ impl Function {
             id::SET_SPEED => Some(Function::SetSpeed),
             id::CLEAR_FAULTS => Some(Function::ClearFaults),
             id::HEARTBEAT => Some(Function::Heartbeat),
+            id::SET_PARAMETER => Some(Function::SetParameter),
+            id::GET_PARAMETER => Some(Function::GetParameter),
+            id::SAVE_PARAMETERS => Some(Function::SaveParameters),
+            id::STEP_TEST => Some(Function::StepTest),
             _ => None,
         }
     }
@@ -222,16 +280,18 @@ impl Function {
     /// Required data length of the command frame. [bytes]
     pub fn dlc(self) -> u8 {
         match self {
-            Function::SetMode => 1,
+            Function::SetMode | Function::GetParameter => 1,
             Function::SetPressure | Function::SetSpeed => 4,
-            Function::ClearFaults | Function::Heartbeat => 0,
+            Function::SetParameter => 5,
+            Function::StepTest => 7,
+            Function::ClearFaults | Function::Heartbeat | Function::SaveParameters => 0,
         }
     }
 }
 
-/// A command as carried on the wire, in wire units (integers, so an encode/decode round
-/// trip is exact).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A command as carried on the wire, in wire units (integers or `f32` bit patterns, so an
+/// encode/decode round trip is exact).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Request {
     /// Switch the operating mode.
     SetMode(Mode),
@@ -249,6 +309,29 @@ pub enum Request {
     ClearFaults,
     /// Keep the command watchdog fed.
     Heartbeat,
+    /// Set a parameter of the live table.
+    SetParameter {
+        /// The parameter.
+        id: ParamId,
+        /// New value. [the parameter's unit]
+        value: f32,
+    },
+    /// Read a parameter of the live table.
+    GetParameter {
+        /// The parameter.
+        id: ParamId,
+    },
+    /// Save the live table to flash.
+    SaveParameters,
+    /// Step one loop's reference for a while, with telemetry at full rate.
+    StepTest {
+        /// The stepped loop.
+        target: StepLoop,
+        /// Step added to the present reference. [A, rad/s or Pa]
+        amplitude: f32,
+        /// How long the step is held. [ms]
+        duration_ms: u16,
+    },
 }
 
 impl Request {
@@ -274,6 +357,10 @@ impl Request {
             Request::SetSpeed { .. } => Function::SetSpeed,
             Request::ClearFaults => Function::ClearFaults,
             Request::Heartbeat => Function::Heartbeat,
+            Request::SetParameter { .. } => Function::SetParameter,
+            Request::GetParameter { .. } => Function::GetParameter,
+            Request::SaveParameters => Function::SaveParameters,
+            Request::StepTest { .. } => Function::StepTest,
         }
     }
 
@@ -285,9 +372,11 @@ impl Request {
         }
     }
 
-    /// The control core's command for this request (setpoints converted to SI units).
-    pub fn to_command(&self) -> Command {
-        match *self {
+    /// The control core's command for this request (setpoints converted to SI units), or
+    /// `None` for a request the application serves itself (`GetParameter` reads
+    /// [`crate::Controller::parameter`], `SaveParameters` writes the flash).
+    pub fn to_command(&self) -> Option<Command> {
+        Some(match *self {
             Request::SetMode(mode) => Command::SetMode(mode),
             Request::SetPressure { pa } => Command::SetPressure {
                 pa: pa as f32 * SETPOINT_PA_PER_LSB,
@@ -297,7 +386,18 @@ impl Request {
             },
             Request::ClearFaults => Command::ClearFaults,
             Request::Heartbeat => Command::Heartbeat,
-        }
+            Request::SetParameter { id, value } => Command::SetParameter { id, value },
+            Request::StepTest {
+                target,
+                amplitude,
+                duration_ms,
+            } => Command::StepTest {
+                target,
+                amplitude,
+                duration_s: f32::from(duration_ms) * 1e-3,
+            },
+            Request::GetParameter { .. } | Request::SaveParameters => return None,
+        })
     }
 
     /// Speed setpoint in SI units, if this is one. [rad/s]
@@ -327,6 +427,8 @@ pub enum RejectReason {
     UnknownFunction,
     /// Value refused for another reason. Code 7.
     Invalid,
+    /// Unknown parameter id or step-test loop code. Code 8.
+    UnknownCode,
 }
 
 impl RejectReason {
@@ -340,6 +442,7 @@ impl RejectReason {
             RejectReason::NotAllowed => 5,
             RejectReason::UnknownFunction => 6,
             RejectReason::Invalid => 7,
+            RejectReason::UnknownCode => 8,
         }
     }
 
@@ -353,6 +456,7 @@ impl RejectReason {
             5 => Some(RejectReason::NotAllowed),
             6 => Some(RejectReason::UnknownFunction),
             7 => Some(RejectReason::Invalid),
+            8 => Some(RejectReason::UnknownCode),
             _ => None,
         }
     }
@@ -404,8 +508,12 @@ pub struct Rejection {
     pub function: u8,
     /// Why.
     pub reason: RejectReason,
-    /// The violated bound in the command's wire unit (Pa, mrad/s, mode code or DLC).
+    /// The violated bound in the command's wire unit (Pa, mrad/s, mode code or DLC); for
+    /// the configuration and test functions the bit pattern of an `f32` in SI units (see
+    /// [`Rejection::si_bound`]).
     pub bound: i32,
+    /// Parameter id (or unknown code) the refusal concerns, `0` for none.
+    pub parameter: u8,
 }
 
 impl Rejection {
@@ -440,12 +548,85 @@ impl Rejection {
             | CommandError::Mode(ModeRefusal::ConditionPresent(f))
             | CommandError::CausePresent(f) => (RejectReason::NotAllowed, i32::from(f.code())),
             CommandError::Mode(ModeRefusal::Transition { .. }) => (RejectReason::NotAllowed, 0),
+            CommandError::Parameter(e) => return Rejection::for_parameter_error(&e),
+            CommandError::StepTest(e) => {
+                let (reason, bound) = match e {
+                    StepTestError::WrongMode { required } => {
+                        (RejectReason::NotAllowed, f32::from(required.code()))
+                    }
+                    StepTestError::BelowMinimum { min } => (RejectReason::BelowMinimum, min),
+                    StepTestError::AboveMaximum { max } => (RejectReason::AboveMaximum, max),
+                    StepTestError::Duration { bound_s } => {
+                        let below = matches!(request, Request::StepTest { duration_ms, .. }
+                            if f32::from(*duration_ms) * 1e-3 < bound_s);
+                        let reason = if below {
+                            RejectReason::BelowMinimum
+                        } else {
+                            RejectReason::AboveMaximum
+                        };
+                        (reason, bound_s)
+                    }
+                };
+                return Rejection::with_si_bound(Function::StepTest, reason, bound, 0);
+            }
         };
         Rejection {
             function,
             reason,
             bound,
+            parameter: 0,
         }
+    }
+
+    /// The reply for a refused `SetParameter`: names the parameter and, for a value out of
+    /// its bounds, the bound.
+    pub fn for_parameter_error(err: &ParamError) -> Rejection {
+        let (reason, bound) = match *err {
+            ParamError::BelowMinimum { min, .. } => (RejectReason::BelowMinimum, min),
+            ParamError::AboveMaximum { max, .. } => (RejectReason::AboveMaximum, max),
+            ParamError::NotANumber { .. }
+            | ParamError::NotWhole { .. }
+            | ParamError::Inconsistent { .. } => (RejectReason::Invalid, 0.0),
+        };
+        Rejection::with_si_bound(Function::SetParameter, reason, bound, err.id().code())
+    }
+
+    /// A refusal of a configuration or test function, with an SI bound.
+    pub fn with_si_bound(
+        function: Function,
+        reason: RejectReason,
+        bound: f32,
+        parameter: u8,
+    ) -> Rejection {
+        Rejection {
+            function: function.code(),
+            reason,
+            // The f32's bit pattern travels in the i32 field unchanged.
+            bound: bound.to_bits() as i32,
+            parameter,
+        }
+    }
+
+    /// The bound in SI units for the configuration and test functions (codes
+    /// `0x20`‥`0x23`), whose bound field is an `f32`; `None` for the others.
+    pub fn si_bound(&self) -> Option<f32> {
+        let configuration = matches!(
+            Function::from_code(self.function),
+            Some(
+                Function::SetParameter
+                    | Function::GetParameter
+                    | Function::SaveParameters
+                    | Function::StepTest,
+            )
+        );
+        let si_reason = matches!(
+            self.reason,
+            RejectReason::BelowMinimum
+                | RejectReason::AboveMaximum
+                | RejectReason::NotAllowed
+                | RejectReason::Invalid
+        );
+        (configuration && si_reason).then(|| f32::from_bits(self.bound as u32))
     }
 
     /// The reply the drive sends for a command frame that failed to decode, or `None` when
@@ -458,17 +639,26 @@ impl Rejection {
                 function: function.code(),
                 reason: RejectReason::WrongLength,
                 bound: i32::from(expected),
+                parameter: 0,
             }),
             DecodeError::UnknownMode { .. } => Some(Rejection {
                 function: Function::SetMode.code(),
                 reason: RejectReason::UnknownMode,
                 bound: i32::from(MODE_CODE_MAX),
+                parameter: 0,
             }),
             DecodeError::UnknownFunction { id } => Some(Rejection {
                 // An 11-bit identifier shifted by 4 fits a byte.
                 function: (id >> 4) as u8,
                 reason: RejectReason::UnknownFunction,
                 bound: 0,
+                parameter: 0,
+            }),
+            DecodeError::UnknownCode { function, code } => Some(Rejection {
+                function: function.code(),
+                reason: RejectReason::UnknownCode,
+                bound: 0,
+                parameter: code,
             }),
             _ => None,
         }
@@ -476,12 +666,19 @@ impl Rejection {
 }
 
 /// A frame sent by the drive.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Reply {
     /// Periodic or acknowledging status.
     Status(Status),
     /// Refused command.
     Reject(Rejection),
+    /// A parameter's value in use (answer to `GetParameter` and `SetParameter`).
+    Parameter {
+        /// The parameter.
+        id: ParamId,
+        /// Its value. [the parameter's unit]
+        value: f32,
+    },
 }
 
 /// A frame the codec cannot turn into a message.
@@ -539,6 +736,13 @@ pub enum DecodeError {
     },
     /// A reject frame whose reserved bytes are not zero.
     ReservedNotZero,
+    /// A parameter id or step-test loop code that does not exist.
+    UnknownCode {
+        /// The function of the frame.
+        function: Function,
+        /// The received code.
+        code: u8,
+    },
 }
 
 /// A value that cannot be put on the wire.
@@ -583,7 +787,45 @@ pub fn decode_command(frame: &Frame, node: NodeId) -> Result<Request, DecodeErro
         }),
         Function::ClearFaults => Ok(Request::ClearFaults),
         Function::Heartbeat => Ok(Request::Heartbeat),
+        Function::SetParameter => Ok(Request::SetParameter {
+            id: parameter_id(function, payload)?,
+            value: read_f32(payload, 1),
+        }),
+        Function::GetParameter => Ok(Request::GetParameter {
+            id: parameter_id(function, payload)?,
+        }),
+        Function::SaveParameters => Ok(Request::SaveParameters),
+        Function::StepTest => {
+            let code = payload.first().copied().unwrap_or(0);
+            let target =
+                StepLoop::from_code(code).ok_or(DecodeError::UnknownCode { function, code })?;
+            let mut ms = [0u8; 2];
+            if let Some(src) = payload.get(5..7) {
+                ms.copy_from_slice(src);
+            }
+            Ok(Request::StepTest {
+                target,
+                amplitude: read_f32(payload, 1),
+                duration_ms: u16::from_le_bytes(ms),
+            })
+        }
     }
+}
+
+/// The parameter id in byte 0 of a parameter command.
+fn parameter_id(function: Function, payload: &[u8]) -> Result<ParamId, DecodeError> {
+    let code = payload.first().copied().unwrap_or(0);
+    ParamId::from_code(code).ok_or(DecodeError::UnknownCode { function, code })
+}
+
+/// Frame setting parameter `id` to `value` [the parameter's unit] on drive `node`.
+pub fn encode_set_parameter(id: ParamId, value: f32, node: NodeId) -> Frame {
+    encode_command(&Request::SetParameter { id, value }, node)
+}
+
+/// Frame asking drive `node` for the value of parameter `id`.
+pub fn encode_get_parameter(id: ParamId, node: NodeId) -> Frame {
+    encode_command(&Request::GetParameter { id }, node)
 }
 
 /// Encodes a command for `node`.
@@ -594,7 +836,21 @@ pub fn encode_command(request: &Request, node: NodeId) -> Frame {
         Request::SetMode(mode) => data[0] = mode.code(),
         Request::SetPressure { pa } => write_i32(&mut data, 0, pa),
         Request::SetSpeed { mrad_s } => write_i32(&mut data, 0, mrad_s),
-        Request::ClearFaults | Request::Heartbeat => {}
+        Request::SetParameter { id, value } => {
+            data[0] = id.code();
+            write_f32(&mut data, 1, value);
+        }
+        Request::GetParameter { id } => data[0] = id.code(),
+        Request::StepTest {
+            target,
+            amplitude,
+            duration_ms,
+        } => {
+            data[0] = target.code();
+            write_f32(&mut data, 1, amplitude);
+            data[5..7].copy_from_slice(&duration_ms.to_le_bytes());
+        }
+        Request::ClearFaults | Request::Heartbeat | Request::SaveParameters => {}
     }
     Frame {
         id,
@@ -620,7 +876,13 @@ pub fn encode_reply(reply: &Reply, node: NodeId) -> Frame {
             data[0] = r.function;
             data[1] = r.reason.code();
             write_i32(&mut data, 2, r.bound);
+            data[6] = r.parameter;
             id::REJECT
+        }
+        Reply::Parameter { id, value } => {
+            data[0] = id.code();
+            write_f32(&mut data, 1, value);
+            id::PARAMETER
         }
     };
     Frame {
@@ -634,7 +896,7 @@ pub fn encode_reply(reply: &Reply, node: NodeId) -> Frame {
 pub fn decode_reply(frame: &Frame, node: NodeId) -> Result<Reply, DecodeError> {
     let frame_node = (frame.id & NODE_MASK) as u8;
     let base = frame.id & !NODE_MASK;
-    if base != id::STATUS && base != id::REJECT {
+    if base != id::STATUS && base != id::REJECT && base != id::PARAMETER {
         return Err(DecodeError::UnknownFunction { id: frame.id });
     }
     if frame_node != node.0 {
@@ -652,8 +914,20 @@ pub fn decode_reply(frame: &Frame, node: NodeId) -> Result<Reply, DecodeError> {
             last_command: b6,
             sequence: b7,
         }))
+    } else if base == id::PARAMETER {
+        if b5 != 0 || b6 != 0 || b7 != 0 {
+            return Err(DecodeError::ReservedNotZero);
+        }
+        let id = ParamId::from_code(b0).ok_or(DecodeError::UnknownCode {
+            function: Function::GetParameter,
+            code: b0,
+        })?;
+        Ok(Reply::Parameter {
+            id,
+            value: f32::from_le_bytes([b1, b2, b3, b4]),
+        })
     } else {
-        if b6 != 0 || b7 != 0 {
+        if b7 != 0 {
             return Err(DecodeError::ReservedNotZero);
         }
         let reason = RejectReason::from_code(b1).ok_or(DecodeError::UnknownReason { code: b1 })?;
@@ -661,6 +935,7 @@ pub fn decode_reply(frame: &Frame, node: NodeId) -> Result<Reply, DecodeError> {
             function: b0,
             reason,
             bound: i32::from_le_bytes([b2, b3, b4, b5]),
+            parameter: b6,
         }))
     }
 }
@@ -677,6 +952,14 @@ fn write_i32(data: &mut [u8; MAX_DLC], at: usize, value: i32) {
     if let Some(dst) = data.get_mut(at..at + 4) {
         dst.copy_from_slice(&value.to_le_bytes());
     }
+}
+
+fn read_f32(bytes: &[u8], at: usize) -> f32 {
+    f32::from_bits(read_i32(bytes, at) as u32)
+}
+
+fn write_f32(data: &mut [u8; MAX_DLC], at: usize, value: f32) {
+    write_i32(data, at, value.to_bits() as i32);
 }
 
 fn wire_bound(si: f32, per_lsb: f32) -> i32 {
@@ -709,320 +992,4 @@ fn to_wire(value: f32, per_lsb: f32, field: &'static str) -> Result<i32, EncodeE
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::supervisor::FaultCode;
-
-    fn node(n: u8) -> NodeId {
-        NodeId::new(n).expect("valid node")
-    }
-
-    #[test]
-    fn command_layout_matches_the_documented_table() {
-        // Bytes written out by hand from the module documentation.
-        let f = encode_command(&Request::SetPressure { pa: 5_000_000 }, node(3));
-        assert_eq!(f.id(), 0x113);
-        assert_eq!(f.payload(), &[0x40, 0x4B, 0x4C, 0x00]);
-        let f = encode_command(&Request::SetSpeed { mrad_s: -1500 }, node(0));
-        assert_eq!(f.id(), 0x120);
-        assert_eq!(f.payload(), &[0x24, 0xFA, 0xFF, 0xFF]);
-        let f = encode_command(&Request::SetMode(Mode::Pressure), node(15));
-        assert_eq!((f.id(), f.payload()), (0x10F, &[3u8][..]));
-        assert_eq!(encode_command(&Request::ClearFaults, node(1)).id(), 0x131);
-        assert_eq!(
-            encode_command(&Request::Heartbeat, node(1)).payload(),
-            &[] as &[u8]
-        );
-    }
-
-    #[test]
-    fn every_command_round_trips() {
-        let requests = [
-            Request::SetMode(Mode::Disabled),
-            Request::SetMode(Mode::Calibrating),
-            Request::SetMode(Mode::Speed),
-            Request::SetMode(Mode::Pressure),
-            Request::SetPressure { pa: 0 },
-            Request::SetPressure { pa: i32::MIN },
-            Request::SetPressure { pa: i32::MAX },
-            Request::SetSpeed { mrad_s: -314_159 },
-            Request::ClearFaults,
-            Request::Heartbeat,
-        ];
-        for n in [0, 7, NODE_MAX] {
-            for r in requests {
-                let frame = encode_command(&r, node(n));
-                assert_eq!(decode_command(&frame, node(n)), Ok(r));
-            }
-        }
-    }
-
-    #[test]
-    fn si_constructors_round_to_the_wire_resolution() {
-        assert_eq!(
-            Request::pressure_from_pa(3.0e6),
-            Ok(Request::SetPressure { pa: 3_000_000 })
-        );
-        assert_eq!(
-            Request::speed_from_rad_s(-12.3456),
-            Ok(Request::SetSpeed { mrad_s: -12_346 })
-        );
-        let back = Request::SetSpeed { mrad_s: 12_345 }
-            .speed_rad_s()
-            .unwrap_or(f32::NAN);
-        assert!((back - 12.345).abs() < 1e-5, "{back}");
-        assert!(Request::pressure_from_pa(f32::NAN).is_err());
-        assert!(Request::pressure_from_pa(3.0e9).is_err());
-        assert!(Request::speed_from_rad_s(f32::INFINITY).is_err());
-    }
-
-    #[test]
-    fn malformed_commands_are_rejected_with_the_reason() {
-        let me = node(2);
-        let f = Frame::new(0x112, &[1, 2, 3]).unwrap();
-        let err = decode_command(&f, me).unwrap_err();
-        assert_eq!(
-            err,
-            DecodeError::WrongLength {
-                function: Function::SetPressure,
-                expected: 4,
-                got: 3
-            }
-        );
-        assert_eq!(
-            Rejection::for_decode_error(&err),
-            Some(Rejection {
-                function: 0x11,
-                reason: RejectReason::WrongLength,
-                bound: 4
-            })
-        );
-
-        let f = Frame::new(0x132, &[0]).unwrap();
-        assert!(matches!(
-            decode_command(&f, me),
-            Err(DecodeError::WrongLength {
-                expected: 0,
-                got: 1,
-                ..
-            })
-        ));
-
-        let f = Frame::new(0x102, &[4]).unwrap();
-        let err = decode_command(&f, me).unwrap_err();
-        assert_eq!(err, DecodeError::UnknownMode { code: 4 });
-        assert_eq!(
-            Rejection::for_decode_error(&err).map(|r| (r.reason, r.bound)),
-            Some((RejectReason::UnknownMode, 3))
-        );
-
-        let f = Frame::new(0x152, &[]).unwrap();
-        let err = decode_command(&f, me).unwrap_err();
-        assert_eq!(err, DecodeError::UnknownFunction { id: 0x152 });
-        assert_eq!(
-            Rejection::for_decode_error(&err).map(|r| r.function),
-            Some(0x15)
-        );
-
-        // Another node's command is ignored silently; so is a reply seen on the bus.
-        let f = Frame::new(0x113, &[0; 4]).unwrap();
-        let err = decode_command(&f, me).unwrap_err();
-        assert_eq!(err, DecodeError::OtherNode { node: 3 });
-        assert_eq!(Rejection::for_decode_error(&err), None);
-        let f = Frame::new(0x182, &[0; 8]).unwrap();
-        assert_eq!(
-            decode_command(&f, me),
-            Err(DecodeError::UnknownFunction { id: 0x182 })
-        );
-    }
-
-    #[test]
-    fn frame_and_node_bounds_are_checked() {
-        assert_eq!(
-            Frame::new(0x800, &[]),
-            Err(DecodeError::IdentifierTooLarge { id: 0x800 })
-        );
-        assert_eq!(
-            Frame::new(0x100, &[0; 9]),
-            Err(DecodeError::PayloadTooLong { len: 9 })
-        );
-        assert_eq!(
-            NodeId::new(16),
-            Err(DecodeError::NodeOutOfRange { node: 16 })
-        );
-        assert!(Frame::new(0x7FF, &[0; 8]).is_ok());
-    }
-
-    #[test]
-    fn status_layout_and_round_trip() {
-        // 5.2 MPa -> 5200 kPa = 0x1450; -31.4 rad/s -> -314 = 0xFEC6.
-        let s = Status::from_si(
-            Mode::Pressure,
-            4,
-            5.2e6,
-            -31.4,
-            Function::SetPressure.code(),
-            200,
-        );
-        let f = encode_reply(&Reply::Status(s), node(5));
-        assert_eq!(f.id(), 0x185);
-        assert_eq!(f.payload(), &[3, 4, 0x50, 0x14, 0xC6, 0xFE, 0x11, 200]);
-        assert_eq!(decode_reply(&f, node(5)), Ok(Reply::Status(s)));
-    }
-
-    #[test]
-    fn status_fields_saturate() {
-        let s = Status::from_si(Mode::Speed, 0, 1.0e9, f32::NAN, NO_COMMAND, 0);
-        assert_eq!((s.pressure_kpa, s.speed_drad_s), (i16::MAX, 0));
-        let s = Status::from_si(Mode::Speed, 0, -1.0e9, -1.0e6, NO_COMMAND, 0);
-        assert_eq!((s.pressure_kpa, s.speed_drad_s), (i16::MIN, i16::MIN));
-    }
-
-    #[test]
-    fn reject_layout_and_round_trip() {
-        // Pressure above a 16 MPa maximum: bound 16_000_000 = 0x00F42400.
-        let r = Rejection {
-            function: 0x11,
-            reason: RejectReason::AboveMaximum,
-            bound: 16_000_000,
-        };
-        let f = encode_reply(&Reply::Reject(r), node(0));
-        assert_eq!(f.id(), 0x190);
-        assert_eq!(f.payload(), &[0x11, 2, 0x00, 0x24, 0xF4, 0x00, 0, 0]);
-        assert_eq!(decode_reply(&f, node(0)), Ok(Reply::Reject(r)));
-        for code in 1..=7 {
-            let reason = RejectReason::from_code(code).unwrap();
-            assert_eq!(reason.code(), code);
-        }
-    }
-
-    #[test]
-    fn malformed_replies_are_rejected() {
-        let me = node(1);
-        assert!(matches!(
-            decode_reply(&Frame::new(0x181, &[0; 7]).unwrap(), me),
-            Err(DecodeError::WrongReplyLength { got: 7 })
-        ));
-        assert_eq!(
-            decode_reply(
-                &Frame::new(0x191, &[0x11, 9, 0, 0, 0, 0, 0, 0]).unwrap(),
-                me
-            ),
-            Err(DecodeError::UnknownReason { code: 9 })
-        );
-        assert_eq!(
-            decode_reply(
-                &Frame::new(0x191, &[0x11, 1, 0, 0, 0, 0, 0, 1]).unwrap(),
-                me
-            ),
-            Err(DecodeError::ReservedNotZero)
-        );
-        assert_eq!(
-            decode_reply(&Frame::new(0x182, &[0; 8]).unwrap(), me),
-            Err(DecodeError::OtherNode { node: 2 })
-        );
-        assert_eq!(
-            decode_reply(&Frame::new(0x111, &[0; 4]).unwrap(), me),
-            Err(DecodeError::UnknownFunction { id: 0x111 })
-        );
-    }
-
-    #[test]
-    fn requests_map_to_core_commands_in_si_units() {
-        assert_eq!(
-            Request::SetPressure { pa: 4_500_000 }.to_command(),
-            Command::SetPressure { pa: 4.5e6 }
-        );
-        assert_eq!(
-            Request::SetSpeed { mrad_s: -2_500 }.to_command(),
-            Command::SetSpeed { rad_s: -2.5 }
-        );
-        assert_eq!(
-            Request::SetMode(Mode::Speed).to_command(),
-            Command::SetMode(Mode::Speed)
-        );
-        assert_eq!(Request::Heartbeat.to_command(), Command::Heartbeat);
-        assert_eq!(Request::ClearFaults.to_command(), Command::ClearFaults);
-    }
-
-    #[test]
-    fn refusals_name_the_violated_bound() {
-        let range = CommandError::PressureOutOfRange {
-            min_pa: 0.0,
-            max_pa: 18e6,
-        };
-        let r = Rejection::for_command_error(&Request::SetPressure { pa: 20_000_000 }, &range);
-        assert_eq!(
-            r,
-            Rejection {
-                function: 0x11,
-                reason: RejectReason::AboveMaximum,
-                bound: 18_000_000
-            }
-        );
-        let r = Rejection::for_command_error(&Request::SetPressure { pa: -5 }, &range);
-        assert_eq!((r.reason, r.bound), (RejectReason::BelowMinimum, 0));
-
-        let speed = CommandError::SpeedOutOfRange { max_rad_s: 200.0 };
-        let r = Rejection::for_command_error(&Request::SetSpeed { mrad_s: -250_000 }, &speed);
-        assert_eq!(
-            (r.function, r.reason, r.bound),
-            (0x12, RejectReason::BelowMinimum, -200_000)
-        );
-        let r = Rejection::for_command_error(&Request::SetSpeed { mrad_s: 250_000 }, &speed);
-        assert_eq!((r.reason, r.bound), (RejectReason::AboveMaximum, 200_000));
-
-        // Over-pressure is fault code 4 in the supervisor's table.
-        let blocked = CommandError::CausePresent(FaultCode::OverPressure);
-        let r = Rejection::for_command_error(&Request::ClearFaults, &blocked);
-        assert_eq!(
-            (r.function, r.reason, r.bound),
-            (0x13, RejectReason::NotAllowed, 4)
-        );
-        let transition = CommandError::Mode(ModeRefusal::Transition {
-            from: Mode::Speed,
-            to: Mode::Calibrating,
-        });
-        let r = Rejection::for_command_error(&Request::SetMode(Mode::Calibrating), &transition);
-        assert_eq!(
-            (r.function, r.reason, r.bound),
-            (0x10, RejectReason::NotAllowed, 0)
-        );
-    }
-
-    #[test]
-    fn mode_codes_are_the_four_documented_ones() {
-        // 0 disabled, 1 calibrating, 2 speed, 3 pressure (module documentation).
-        let documented = [
-            Mode::Disabled,
-            Mode::Calibrating,
-            Mode::Speed,
-            Mode::Pressure,
-        ];
-        for (code, mode) in documented.into_iter().enumerate() {
-            let f = encode_command(&Request::SetMode(mode), node(0));
-            assert_eq!(f.payload(), &[code as u8]);
-        }
-        assert_eq!(usize::from(MODE_CODE_MAX) + 1, documented.len());
-        let f = Frame::new(0x100, &[MODE_CODE_MAX + 1]).unwrap();
-        assert!(matches!(
-            decode_command(&f, node(0)),
-            Err(DecodeError::UnknownMode { .. })
-        ));
-    }
-
-    #[test]
-    fn function_codes_are_the_identifier_base_shifted() {
-        for f in [
-            Function::SetMode,
-            Function::SetPressure,
-            Function::SetSpeed,
-            Function::ClearFaults,
-            Function::Heartbeat,
-        ] {
-            assert_eq!(u16::from(f.code()) << 4, f.id_base());
-            assert_eq!(Function::from_code(f.code()), Some(f));
-        }
-        assert_eq!(Function::from_code(0x18), None);
-    }
-}
+mod tests;

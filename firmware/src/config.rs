@@ -27,6 +27,9 @@ pub struct Rates {
     pub speed_loop_hz: f32,
     /// Pressure-loop rate; `pwm_hz / pressure_loop_hz` must be a whole number. [Hz]
     pub pressure_loop_hz: f32,
+    /// PWM periods per telemetry frame (1..=10 000); 20 gives 1 kHz at 20 kHz PWM. A step
+    /// test forces 1 (full rate) while it runs. [1]
+    pub telemetry_decimation: u32,
 }
 
 /// Conversion of the raw peripheral readings to SI.
@@ -264,6 +267,7 @@ impl Config {
                 pwm_hz: 20_000.0,
                 speed_loop_hz: 2_000.0,
                 pressure_loop_hz: 1_000.0,
+                telemetry_decimation: 20,
             },
             sensors: SensorScaling {
                 current_a_per_lsb: 100.0 / 4096.0,
@@ -367,6 +371,13 @@ impl Config {
             return Err(err(
                 "rates.pressure_loop_hz",
                 "must be at least 10x the pressure-loop bandwidth",
+            ));
+        }
+
+        if !(1..=10_000).contains(&r.telemetry_decimation) {
+            return Err(err(
+                "rates.telemetry_decimation",
+                "must be within 1..=10000",
             ));
         }
 

@@ -12,6 +12,13 @@
 //! Disabled (the simulator does). Calibrating measures both and replaces them; it ends in
 //! Disabled.
 //!
+//! Parameters ([`Command::SetParameter`]) and step tests ([`Command::StepTest`]) are
+//! applied inside [`Controller::command`], which never runs during a control step: on the
+//! target the command path and the current-loop interrupt share one critical-section
+//! mutex, on the host they are sequential calls. A change therefore takes effect at the
+//! start of the next step, with no pending-change buffer to keep; gains move bumplessly
+//! ([`crate::pi::Pi::set_gains`]: the integral absorbs the change of the proportional term).
+//!
 //! Entering Pressure holds the measured pressure until a pressure setpoint is commanded;
 //! the pressure loop starts bumplessly from the present speed reference. Entering Speed
 //! uses the last commanded speed setpoint (0 if none).
@@ -21,9 +28,12 @@ use crate::config::{whole_ratio, Config};
 use crate::current_loop::{CurrentLoop, CurrentLoopState};
 use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
 use crate::io::{Measurements, Outputs};
+use crate::parameters::{ParamError, ParamId};
+use crate::pi::saturate;
 use crate::pressure_loop::PressureLoop;
 use crate::speed_loop::SpeedLoop;
 use crate::speed_observer::SpeedObserver;
+use crate::step_test::{self, ActiveStep, StepLoop, StepTestError};
 use crate::supervisor::{Conditions, FaultCode, Mode, ModeRefusal, Supervisor};
 use crate::telemetry::TelemetryFrame;
 use crate::transforms::{wrap_2pi, Dq};
@@ -52,6 +62,23 @@ pub enum Command {
     /// (motor identification and gain design, [`crate::commissioning`]) instead of the
     /// plain encoder alignment.
     Commission,
+    /// Sets one parameter of the live table (bounds: [`ParamId::min`], [`ParamId::max`]).
+    SetParameter {
+        /// The parameter.
+        id: ParamId,
+        /// New value. [the parameter's unit]
+        value: f32,
+    },
+    /// Steps one loop's reference for a while with telemetry at full rate
+    /// ([`crate::step_test`]).
+    StepTest {
+        /// The stepped loop.
+        target: StepLoop,
+        /// Step added to the present reference. [A, rad/s or Pa]
+        amplitude: f32,
+        /// How long the step is held. [s]
+        duration_s: f32,
+    },
 }
 
 /// Why a command was refused. Its [`CommandError::code`] shows in telemetry.
@@ -75,6 +102,10 @@ pub enum CommandError {
     Mode(ModeRefusal),
     /// ClearFaults refused: the fault's cause is still present.
     CausePresent(FaultCode),
+    /// Parameter value refused.
+    Parameter(ParamError),
+    /// Step test refused.
+    StepTest(StepTestError),
 }
 
 impl CommandError {
@@ -87,6 +118,8 @@ impl CommandError {
             CommandError::Mode(ModeRefusal::ConditionPresent(_)) => 4,
             CommandError::Mode(ModeRefusal::Transition { .. }) => 5,
             CommandError::CausePresent(_) => 6,
+            CommandError::Parameter(_) => 7,
+            CommandError::StepTest(_) => 8,
         }
     }
 }
@@ -112,6 +145,19 @@ impl fmt::Display for CommandError {
                 write!(f, "mode refused: {from:?} -> {to:?} (go through Disabled)")
             }
             CommandError::CausePresent(x) => write!(f, "clear refused: cause still present ({x})"),
+            CommandError::Parameter(e) => write!(f, "parameter refused: {e}"),
+            CommandError::StepTest(StepTestError::WrongMode { required }) => {
+                write!(f, "step test refused: needs mode {required:?}")
+            }
+            CommandError::StepTest(StepTestError::BelowMinimum { min }) => {
+                write!(f, "step test refused: amplitude below {min} (loop limit)")
+            }
+            CommandError::StepTest(StepTestError::AboveMaximum { max }) => {
+                write!(f, "step test refused: amplitude above {max} (loop limit)")
+            }
+            CommandError::StepTest(StepTestError::Duration { bound_s }) => {
+                write!(f, "step test refused: duration beyond {bound_s} s")
+            }
         }
     }
 }
@@ -171,6 +217,7 @@ pub struct Controller {
     commission_speed_on: bool,
     /// The current loop runs at a forced angle this period (no speed decoupling).
     forced_frame: bool,
+    step: Option<ActiveStep>,
 }
 
 impl Controller {
@@ -233,7 +280,35 @@ impl Controller {
             open_loop_voltage: None,
             commission_speed_on: false,
             forced_frame: false,
+            step: None,
         }
+    }
+
+    /// Value of a live parameter. [the parameter's unit]
+    pub fn parameter(&self, id: ParamId) -> f32 {
+        id.get(&self.cfg)
+    }
+
+    /// PWM periods per telemetry frame the application should log at now: 1 while a step
+    /// test runs, else `rates.telemetry_decimation`.
+    pub fn telemetry_decimation(&self) -> u32 {
+        if self.step.is_some_and(|s| s.remaining > 0) {
+            1
+        } else {
+            self.cfg.rates.telemetry_decimation
+        }
+    }
+
+    /// The running step test, if any.
+    pub fn step_test(&self) -> Option<ActiveStep> {
+        self.step
+    }
+
+    /// Boot entry point: the stored parameter table could not be used and the defaults
+    /// were loaded. Latches [`FaultCode::ParameterStoreInvalid`], so the drive will not
+    /// start until the operator has seen it and cleared it.
+    pub fn report_parameter_store_invalid(&mut self) {
+        self.sup.trip(FaultCode::ParameterStoreInvalid);
     }
 
     /// Configuration in use.
@@ -318,6 +393,9 @@ impl Controller {
         if mode.is_active() && !self.active_last_call {
             self.on_enter_active(mode);
         }
+        if let Some(step) = self.step {
+            self.advance_step(step, mode);
+        }
 
         // Pressure loop tick (before the speed loop so it uses the fresh reference).
         self.pressure_tick += 1;
@@ -341,7 +419,15 @@ impl Controller {
             match mode {
                 Mode::Speed => {
                     self.speed_ref = self.speed_setpoint;
-                    self.iq_ref = self.speed.step(self.speed_ref, w);
+                    self.iq_ref = match self.step {
+                        // A current step suspends the speed loop (its integral is held).
+                        Some(ActiveStep {
+                            target: StepLoop::Current,
+                            stepped,
+                            ..
+                        }) => stepped,
+                        _ => self.speed.step(self.speed_ref, w),
+                    };
                 }
                 Mode::Pressure => self.iq_ref = self.speed.step(self.speed_ref, w),
                 Mode::Calibrating => self.commission_speed_tick(w),
@@ -504,6 +590,8 @@ impl Controller {
                     let raw =
                         self.encoder.electrical_angle(m.encoder_count) + self.encoder.offset();
                     self.encoder.set_offset(wrap_2pi(raw));
+                    // The live table (and a later save) holds the measured offset.
+                    self.cfg.sensors.encoder_offset_rad = self.encoder.offset();
                     self.calibrated = true;
                     self.id_ref = 0.0;
                     self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
@@ -531,8 +619,27 @@ impl Controller {
     }
 
     fn apply(&mut self, c: Command) -> Result<(), CommandError> {
+        if matches!(
+            c,
+            Command::SetPressure { .. } | Command::SetSpeed { .. } | Command::SetMode(_)
+        ) {
+            // A new setpoint or mode supersedes a running step test; the new value wins,
+            // so the test ends without restoring its base.
+            self.step = None;
+        }
         match c {
             Command::Heartbeat => Ok(()),
+            Command::SetParameter { id, value } => {
+                id.set(&mut self.cfg, value)
+                    .map_err(CommandError::Parameter)?;
+                self.retune(id);
+                Ok(())
+            }
+            Command::StepTest {
+                target,
+                amplitude,
+                duration_s,
+            } => self.start_step(target, amplitude, duration_s),
             Command::SetPressure { pa } => {
                 let p = &self.cfg.pressure;
                 if pa.is_nan() || pa < p.setpoint_min_pa || pa > p.setpoint_max_pa {
@@ -578,6 +685,109 @@ impl Controller {
                 }
                 self.commission_requested = false;
                 Ok(())
+            }
+        }
+    }
+
+    /// Brings the loops to the configuration after parameter `id` changed. Every loop is
+    /// retuned (cheap, and a no-op for an unchanged value); gains and limits move without
+    /// resetting any state, so the outputs do not jump.
+    fn retune(&mut self, id: ParamId) {
+        self.current.retune(&self.cfg);
+        self.speed.retune(&self.cfg);
+        self.observer
+            .set_bandwidth(self.cfg.speed.observer_bandwidth_rad_s);
+        self.pressure.retune(&self.cfg);
+        if id == ParamId::EncoderOffset {
+            self.encoder.set_offset(self.cfg.sensors.encoder_offset_rad);
+        }
+        // Setpoints held from before a limit change stay within the new limits.
+        let p = &self.cfg.pressure;
+        if let Some(t) = self.pressure_target {
+            let t = saturate(t, p.setpoint_min_pa, p.setpoint_max_pa);
+            self.pressure_target = Some(t);
+            self.pressure.set_target(t);
+        }
+        let w = self.cfg.speed.speed_limit_rad_s;
+        self.speed_setpoint = saturate(self.speed_setpoint, -w, w);
+    }
+
+    /// Starts a step test (ending a running one first, with its base restored).
+    fn start_step(
+        &mut self,
+        target: StepLoop,
+        amplitude: f32,
+        duration_s: f32,
+    ) -> Result<(), CommandError> {
+        let required = target.mode();
+        if self.sup.mode() != required {
+            return Err(CommandError::StepTest(StepTestError::WrongMode {
+                required,
+            }));
+        }
+        if let Some(s) = self.step {
+            self.end_step(s);
+        }
+        let (reference, lo, hi) = match target {
+            StepLoop::Current => {
+                let l = self.cfg.speed.iq_limit_a;
+                (self.iq_ref, -l, l)
+            }
+            StepLoop::Speed => {
+                let l = self.cfg.speed.speed_limit_rad_s;
+                (self.speed_setpoint, -l, l)
+            }
+            StepLoop::Pressure => {
+                let p = &self.cfg.pressure;
+                let now = self.pressure_target.unwrap_or(self.pressure.setpoint());
+                (now, p.setpoint_min_pa, p.setpoint_max_pa)
+            }
+        };
+        let s = step_test::plan(
+            target,
+            amplitude,
+            duration_s,
+            reference,
+            (lo, hi),
+            self.d.pwm_hz as f32,
+        )
+        .map_err(CommandError::StepTest)?;
+        self.set_step_reference(target, s.stepped);
+        self.step = Some(s);
+        Ok(())
+    }
+
+    /// Counts a running step test down at the start of a period (this period is stepped
+    /// while any remain); ends it when its time is up or its mode was left.
+    #[inline]
+    fn advance_step(&mut self, step: ActiveStep, mode: Mode) {
+        if mode != step.target.mode() || step.remaining == 0 {
+            self.end_step(step);
+        } else {
+            self.step = Some(ActiveStep {
+                remaining: step.remaining - 1,
+                ..step
+            });
+        }
+    }
+
+    /// Ends a step test and restores the reference it stepped from.
+    fn end_step(&mut self, step: ActiveStep) {
+        self.step = None;
+        match step.target {
+            // The speed loop resumes from the stepped current: its integral takes it.
+            StepLoop::Current => self.speed.set_integral(step.stepped),
+            target => self.set_step_reference(target, step.base),
+        }
+    }
+
+    fn set_step_reference(&mut self, target: StepLoop, value: f32) {
+        match target {
+            StepLoop::Current => self.iq_ref = value,
+            StepLoop::Speed => self.speed_setpoint = value,
+            StepLoop::Pressure => {
+                self.pressure_target = Some(value);
+                self.pressure.set_target(value);
             }
         }
     }

@@ -67,6 +67,21 @@ impl CurrentLoop {
         }
     }
 
+    /// Takes changed gains, voltage limit and machine constants from `cfg` without
+    /// resetting the integrators (bumpless, [`Pi::set_gains`]).
+    pub fn retune(&mut self, cfg: &crate::config::Config) {
+        let c = &cfg.current;
+        let lim = c.voltage_limit_v;
+        self.pi_d.set_limits(-lim, lim);
+        self.pi_q.set_limits(-lim, lim);
+        self.pi_d.set_gains(c.kp_d, c.ki_d);
+        self.pi_q.set_gains(c.kp_q, c.ki_q);
+        self.l_d = cfg.motor.d_inductance_h;
+        self.l_q = cfg.motor.q_inductance_h;
+        self.psi_f = cfg.motor.flux_linkage_wb;
+        self.decoupling = c.decoupling;
+    }
+
     /// Sets the calibrated zero-current ADC results. [counts]
     pub fn set_offsets(&mut self, offsets_lsb: [f32; 3]) {
         self.offsets_lsb = offsets_lsb;

@@ -14,16 +14,20 @@
 
 pub mod can_protocol;
 pub mod commissioning;
+pub mod can_server;
 pub mod config;
 pub mod controller;
 pub mod current_loop;
 pub mod encoder;
 pub mod io;
+pub mod param_store;
+pub mod parameters;
 pub mod pi;
 pub mod pressure_loop;
 pub mod scaling;
 pub mod speed_loop;
 pub mod speed_observer;
+pub mod step_test;
 pub mod supervisor;
 pub mod svpwm;
 pub mod telemetry;

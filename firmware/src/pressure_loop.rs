@@ -130,6 +130,23 @@ impl PressureLoop {
         pl
     }
 
+    /// Takes changed design parameters, hydraulic assumptions and the speed limit from
+    /// `cfg` keeping the integral, the filter and the ramp state; the schedule's gains
+    /// follow at the next step through [`Pi::set_gains`] (bumpless).
+    pub fn retune(&mut self, cfg: &Config) {
+        let t = 1.0 / cfg.rates.pressure_loop_hz;
+        let p = &cfg.pressure;
+        let lim = cfg.speed.speed_limit_rad_s;
+        self.pi.set_limits(-lim, lim);
+        self.hydraulics = cfg.hydraulics;
+        self.k_q = cfg.hydraulics.pump_displacement_m3_per_rev / core::f32::consts::TAU;
+        self.bandwidth = p.bandwidth_rad_s;
+        self.corner_ratio = p.integral_corner_ratio;
+        self.filter_alpha = 1.0 - libm::expf(-p.feedback_filter_rad_s * t);
+        self.ramp_step = p.ramp_pa_per_s * t;
+        self.ramp_rate = p.ramp_pa_per_s;
+    }
+
     /// The schedule: gains at gauge pressure `p` [Pa].
     pub fn gains_at(&self, p: f32) -> PressureGains {
         let kp = self.bandwidth * capacitance(&self.hydraulics, p) / self.k_q;

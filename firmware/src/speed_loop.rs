@@ -58,6 +58,20 @@ impl SpeedLoop {
         }
     }
 
+    /// Takes changed gains, damping and current limit from `cfg` without resetting the
+    /// integral (bumpless, [`Pi::set_gains`]).
+    pub fn retune(&mut self, cfg: &crate::config::Config) {
+        let s = &cfg.speed;
+        self.pi.set_limits(-s.iq_limit_a, s.iq_limit_a);
+        self.pi.set_gains(s.kp, s.ki);
+        self.active_damping = s.active_damping;
+    }
+
+    /// Sets the integral to `iq` [A] (the loop resumes from there after a current step).
+    pub fn set_integral(&mut self, iq: f32) {
+        self.pi.reset(iq);
+    }
+
     /// Measures the speed from the observer's angle estimate `angle` [counts] taken once
     /// per speed period; returns it. [rad/s]
     #[inline]

@@ -140,6 +140,14 @@ impl SpeedObserver {
         }
     }
 
+    /// Changes the bandwidth ω_n [rad/s] keeping the angle and speed estimates, so the
+    /// estimate does not jump.
+    pub fn set_bandwidth(&mut self, bandwidth_rad_s: f32) {
+        let wn = bandwidth_rad_s.max(0.0);
+        self.kp = 2.0 * DAMPING * wn;
+        self.ki_t = wn * wn * self.t;
+    }
+
     /// Restarts at rest at `position`. [counts]
     pub fn reset(&mut self, position: i64) {
         self.angle = EstimatedAngle {

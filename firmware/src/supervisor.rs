@@ -88,11 +88,14 @@ pub enum FaultCode {
     /// Commissioning: the encoder moved backwards (reversed), not at all, or the shaft did
     /// not follow the current vector. (15)
     CommissioningEncoder = 15,
+    /// The stored parameter table was corrupt, of another version or inconsistent: the
+    /// defaults were loaded instead. (16)
+    ParameterStoreInvalid = 16,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 15] = [
+    pub const ALL: [FaultCode; 16] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -108,9 +111,10 @@ impl FaultCode {
         FaultCode::CommissioningCurrent,
         FaultCode::CommissioningImplausible,
         FaultCode::CommissioningEncoder,
+        FaultCode::ParameterStoreInvalid,
     ];
 
-    /// Telemetry code (1..=15).
+    /// Telemetry code (1..=16).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -137,6 +141,7 @@ impl FaultCode {
                 | FaultCode::CommissioningCurrent
                 | FaultCode::CommissioningImplausible
                 | FaultCode::CommissioningEncoder
+                | FaultCode::ParameterStoreInvalid
         )
     }
 }
@@ -161,6 +166,7 @@ impl fmt::Display for FaultCode {
             FaultCode::CommissioningEncoder => {
                 "commissioning: encoder reversed or shaft not moving"
             }
+            FaultCode::ParameterStoreInvalid => "stored parameters invalid, defaults loaded",
         };
         write!(f, "fault {}: {}", self.code(), s)
     }
@@ -313,6 +319,11 @@ mod tests {
             seen |= f.bit();
         }
         assert_eq!(FaultCode::from_code(0), None);
+        // Code 16 is the documented parameter-store fault.
+        assert_eq!(
+            FaultCode::from_code(16),
+            Some(FaultCode::ParameterStoreInvalid)
+        );
         for m in [
             Mode::Disabled,
             Mode::Calibrating,

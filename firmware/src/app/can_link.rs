@@ -92,7 +92,8 @@ pub async fn transmit(mut tx: CanTx<'static>, node: NodeId) {
 }
 
 fn execute(request: &Request) -> Option<Outgoing> {
-    let result = control::with_controller(|c| c.command(request.to_command()))?;
+    let command = request.to_command()?;
+    let result = control::with_controller(|c| c.command(command))?;
     match result {
         Ok(()) if *request == Request::Heartbeat => None,
         Ok(()) => Some(Outgoing::Ack(request.function().code())),

@@ -1,0 +1,310 @@
+//! Persistence of the live parameter table ([`crate::parameters`]) in NOR flash: two
+//! erase pages used alternately (A/B), each holding at most one record with a format
+//! version, a table fingerprint, a sequence number and a CRC-32, completed by a separate
+//! commit word written last.
+//!
+//! Generic over [`embedded_storage::nor_flash::NorFlash`], so the same code runs on the
+//! G474's flash and on a RAM-backed flash in the host tests.
+//!
+//! # Why two pages and a commit word
+//!
+//! A save erases and writes only the page that does *not* hold the newest valid record,
+//! so the previous table stays intact until the new one is complete: a power cut at any
+//! point of a save (during the erase, the record, or the commit word; mid-word included)
+//! leaves the old record readable, and the next load returns the old table or the new one,
+//! never a mixture. A record counts only when its CRC matches *and* its commit word is
+//! present; the commit word is written after the record, so a record interrupted after
+//! its last data word but before the commit is not taken either. The sequence number
+//! (newer = larger) decides between two valid pages. Two pages cost 2 erase pages of
+//! flash; a log-structured store (e.g. `sequential-storage`) would level wear, but the
+//! table is saved by an operator, a few times in a drive's life, far below the 10 000
+//! erase cycles of the G4's flash, and the A/B scheme is a fraction of the code size
+//! (the firmware budget is 64 KiB).
+//!
+//! # Record layout (little endian, from the page start)
+//!
+//! | offset | size | content                                                      |
+//! |--------|------|--------------------------------------------------------------|
+//! | 0      | 4    | magic `0x5041_4845` (bytes `E H A P`)                        |
+//! | 4      | 2    | format version ([`FORMAT_VERSION`])                          |
+//! | 6      | 2    | number of values ([`crate::parameters::COUNT`])              |
+//! | 8      | 4    | sequence number                                              |
+//! | 12     | 4    | table fingerprint ([`crate::parameters::layout_fingerprint`]) |
+//! | 16     | 4·N  | values, `f32`, in [`crate::parameters::ParamId::ALL`] order  |
+//! | 16+4N  | 4    | CRC-32 (ISO-HDLC) of bytes 0‥16+4N                           |
+//! | …      |      | `0xFF` padding to a multiple of 8 bytes                      |
+//! | R      | 8    | commit word: `0x544D_4D43` (`C M M T`), then the sequence number |
+//!
+//! with R = [`RECORD_LEN`]. Both the record and the commit word are multiples of 8 bytes,
+//! the G4's programming unit (one double word with ECC).
+//!
+//! # Loading
+//!
+//! [`ParamStore::load`] takes the valid record with the larger sequence number. Without
+//! one, the outcome says why: both pages blank (never saved: defaults, no fault), or a
+//! record that is corrupt or of another format version or table (defaults and fault 16,
+//! [`crate::FaultCode::ParameterStoreInvalid`]). [`boot_config`] also refuses a
+//! record whose values are out of their bounds or inconsistent, so the controller never
+//! starts from garbage.
+
+use crate::config::Config;
+use crate::parameters::{self, COUNT};
+use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
+use embedded_storage::nor_flash::NorFlash;
+
+/// CRC-32 used for the record and the table fingerprint (bitwise: no 1 KiB lookup table in
+/// flash; a record is checked once per boot and save).
+pub const CRC: Crc<u32, NoTable> = Crc::<u32, NoTable>::new(&CRC_32_ISO_HDLC);
+
+/// Format version of the record; a record of another version is not loaded.
+pub const FORMAT_VERSION: u16 = 1;
+/// Record magic (`E H A P` in memory order).
+pub const MAGIC: u32 = 0x5041_4845;
+/// Commit-word magic (`C M M T` in memory order).
+pub const COMMIT_MAGIC: u32 = 0x544D_4D43;
+
+const HEADER_LEN: usize = 16;
+const CRC_AT: usize = HEADER_LEN + 4 * COUNT;
+/// Length of the record with its padding, before the commit word. [bytes]
+pub const RECORD_LEN: usize = (CRC_AT + 4 + 7) / 8 * 8;
+/// Length of the commit word. [bytes]
+pub const COMMIT_LEN: usize = 8;
+/// Bytes a record occupies in its page. [bytes]
+pub const SPAN: usize = RECORD_LEN + COMMIT_LEN;
+
+/// What a page holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Page {
+    /// Erased header: never written (or the erase of a save was the last thing done).
+    Blank,
+    /// A complete record of this format and table.
+    Valid { sequence: u32, values: [f32; COUNT] },
+    /// A record of another format version or parameter table.
+    OtherVersion,
+    /// Anything else: bad magic, bad CRC, missing commit word.
+    Corrupt,
+}
+
+/// Result of a load.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadOutcome {
+    /// A valid record, with its sequence number.
+    Loaded {
+        /// The record's sequence number.
+        sequence: u32,
+    },
+    /// Both pages blank: nothing was ever saved (defaults, not a fault).
+    Blank,
+    /// No valid record, and at least one of another version or table (fault 16).
+    OtherVersion,
+    /// No valid record, and at least one corrupt page (fault 16).
+    Corrupt,
+}
+
+/// Why a store could not be opened or a save failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StoreError<E> {
+    /// The page offsets are not erase-page aligned, overlap, or the flash's programming
+    /// unit does not divide 8 bytes, or a page is smaller than a record.
+    Layout,
+    /// The flash driver failed.
+    Flash(E),
+}
+
+/// The two pages of the parameter table on a flash.
+#[derive(Debug)]
+pub struct ParamStore<F> {
+    flash: F,
+    pages: [u32; 2],
+}
+
+impl<F: NorFlash> ParamStore<F> {
+    /// Opens the store on pages at offsets `page_a` and `page_b` of `flash` (offsets as the
+    /// driver counts them, each the start of an erase page).
+    pub fn new(flash: F, page_a: u32, page_b: u32) -> Result<ParamStore<F>, StoreError<F::Error>> {
+        let erase = F::ERASE_SIZE as u32;
+        let fits = F::WRITE_SIZE > 0
+            && 8 % F::WRITE_SIZE == 0
+            && F::ERASE_SIZE >= SPAN
+            && page_a % erase == 0
+            && page_b % erase == 0
+            && page_a != page_b
+            && [page_a, page_b]
+                .iter()
+                .all(|p| (*p as usize).saturating_add(F::ERASE_SIZE) <= flash.capacity());
+        if !fits {
+            return Err(StoreError::Layout);
+        }
+        Ok(ParamStore {
+            flash,
+            pages: [page_a, page_b],
+        })
+    }
+
+    /// Gives the flash back.
+    pub fn into_inner(self) -> F {
+        self.flash
+    }
+
+    fn read_page(&mut self, page: u32) -> Page {
+        let mut buf = [0u8; SPAN];
+        if self.flash.read(page, &mut buf).is_err() {
+            return Page::Corrupt;
+        }
+        parse(&buf)
+    }
+
+    /// The newest valid table, if any, and what the pages held.
+    pub fn load(&mut self) -> (Option<[f32; COUNT]>, LoadOutcome) {
+        let pages = self.pages.map(|p| self.read_page(p));
+        match newest(&pages) {
+            Some((_, sequence, values)) => (Some(values), LoadOutcome::Loaded { sequence }),
+            None if pages.iter().all(|p| *p == Page::Blank) => (None, LoadOutcome::Blank),
+            None if pages.contains(&Page::OtherVersion) => (None, LoadOutcome::OtherVersion),
+            None => (None, LoadOutcome::Corrupt),
+        }
+    }
+
+    /// Saves `values` (in [`parameters::ParamId::ALL`] order) as the newest record: erases
+    /// the page not holding the newest valid record, writes the record, then the commit
+    /// word. Returns the new record's sequence number.
+    pub fn save(&mut self, values: &[f32; COUNT]) -> Result<u32, StoreError<F::Error>> {
+        let pages = self.pages.map(|p| self.read_page(p));
+        let [a, b] = self.pages;
+        let (page, sequence) = match newest(&pages) {
+            Some((0, sequence, _)) => (b, sequence.wrapping_add(1)),
+            Some((_, sequence, _)) => (a, sequence.wrapping_add(1)),
+            None => (a, 1),
+        };
+        let record = encode(sequence, values);
+        let mut commit = [0u8; COMMIT_LEN];
+        commit[..4].copy_from_slice(&COMMIT_MAGIC.to_le_bytes());
+        commit[4..].copy_from_slice(&sequence.to_le_bytes());
+        self.flash
+            .erase(page, page + F::ERASE_SIZE as u32)
+            .map_err(StoreError::Flash)?;
+        self.flash.write(page, &record).map_err(StoreError::Flash)?;
+        self.flash
+            .write(page + RECORD_LEN as u32, &commit)
+            .map_err(StoreError::Flash)?;
+        Ok(sequence)
+    }
+}
+
+/// The valid page with the largest sequence number: (page index, sequence, values).
+fn newest(pages: &[Page; 2]) -> Option<(usize, u32, [f32; COUNT])> {
+    let mut best: Option<(usize, u32, [f32; COUNT])> = None;
+    for (i, p) in pages.iter().enumerate() {
+        if let Page::Valid { sequence, values } = *p {
+            if best.is_none_or(|(_, s, _)| sequence > s) {
+                best = Some((i, sequence, values));
+            }
+        }
+    }
+    best
+}
+
+/// The record bytes (without the commit word) for `values`.
+fn encode(sequence: u32, values: &[f32; COUNT]) -> [u8; RECORD_LEN] {
+    let mut r = [0xFFu8; RECORD_LEN];
+    r[0..4].copy_from_slice(&MAGIC.to_le_bytes());
+    r[4..6].copy_from_slice(&FORMAT_VERSION.to_le_bytes());
+    // COUNT is a few dozen: fits u16.
+    r[6..8].copy_from_slice(&(COUNT as u16).to_le_bytes());
+    r[8..12].copy_from_slice(&sequence.to_le_bytes());
+    r[12..16].copy_from_slice(&parameters::layout_fingerprint().to_le_bytes());
+    for (chunk, v) in r[HEADER_LEN..CRC_AT].chunks_exact_mut(4).zip(values) {
+        chunk.copy_from_slice(&v.to_le_bytes());
+    }
+    let crc = CRC.checksum(&r[..CRC_AT]);
+    r[CRC_AT..CRC_AT + 4].copy_from_slice(&crc.to_le_bytes());
+    r
+}
+
+fn u32_at(b: &[u8], at: usize) -> u32 {
+    let mut w = [0u8; 4];
+    if let Some(src) = b.get(at..at + 4) {
+        w.copy_from_slice(src);
+    }
+    u32::from_le_bytes(w)
+}
+
+/// Classifies a page's first [`SPAN`] bytes.
+fn parse(b: &[u8; SPAN]) -> Page {
+    if b[..HEADER_LEN].iter().all(|x| *x == 0xFF) {
+        return Page::Blank;
+    }
+    if u32_at(b, 0) != MAGIC {
+        return Page::Corrupt;
+    }
+    let version = u16::from_le_bytes([b[4], b[5]]);
+    let count = u16::from_le_bytes([b[6], b[7]]);
+    if version != FORMAT_VERSION
+        || usize::from(count) != COUNT
+        || u32_at(b, 12) != parameters::layout_fingerprint()
+    {
+        return Page::OtherVersion;
+    }
+    let sequence = u32_at(b, 8);
+    if CRC.checksum(&b[..CRC_AT]) != u32_at(b, CRC_AT)
+        || u32_at(b, RECORD_LEN) != COMMIT_MAGIC
+        || u32_at(b, RECORD_LEN + 4) != sequence
+    {
+        return Page::Corrupt;
+    }
+    let mut values = [0f32; COUNT];
+    for (v, chunk) in values.iter_mut().zip(b[HEADER_LEN..CRC_AT].chunks_exact(4)) {
+        *v = f32::from_bits(u32_at(chunk, 0));
+    }
+    Page::Valid { sequence, values }
+}
+
+/// What boot made of the store.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BootOutcome {
+    /// The stored table is in use.
+    Stored {
+        /// Its sequence number.
+        sequence: u32,
+    },
+    /// Nothing stored: defaults, no fault.
+    Defaults,
+    /// The stored table was unusable (corrupt, another version, or values refused):
+    /// defaults are in use and fault 16 must be reported.
+    DefaultsAfterInvalid(LoadOutcome),
+}
+
+impl BootOutcome {
+    /// True when the controller must latch [`crate::FaultCode::ParameterStoreInvalid`].
+    pub fn is_fault(&self) -> bool {
+        matches!(self, BootOutcome::DefaultsAfterInvalid(_))
+    }
+}
+
+/// The configuration to boot with: `defaults` with the stored table applied, or
+/// `defaults` alone when nothing usable is stored. A record whose values fail their
+/// bounds or [`Config::validate`] counts as invalid.
+pub fn boot_config<F: NorFlash>(
+    store: &mut ParamStore<F>,
+    defaults: &Config,
+) -> (Config, BootOutcome) {
+    let (values, outcome) = store.load();
+    let mut cfg = *defaults;
+    match (values, outcome) {
+        (Some(v), LoadOutcome::Loaded { sequence }) => {
+            if parameters::apply_all(&mut cfg, &v).is_ok() {
+                (cfg, BootOutcome::Stored { sequence })
+            } else {
+                (
+                    *defaults,
+                    BootOutcome::DefaultsAfterInvalid(LoadOutcome::Corrupt),
+                )
+            }
+        }
+        (_, LoadOutcome::Blank) => (cfg, BootOutcome::Defaults),
+        (_, other) => (cfg, BootOutcome::DefaultsAfterInvalid(other)),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,384 @@
+//! Store tests on a RAM-backed NOR flash that can lose power after any number of byte
+//! operations: a save cut at every possible point (inside the erase, inside a double
+//! word of the record, inside the commit word) must leave the previous table loadable;
+//! corrupt, other-version and out-of-bounds records fall back to the defaults with the
+//! fault. Records for the layout tests are built here from the module's table, not with
+//! the module's encoder.
+
+use super::*;
+use crate::parameters::ParamId;
+use embedded_storage::nor_flash::{ErrorType, NorFlashError, NorFlashErrorKind, ReadNorFlash};
+use std::vec::Vec;
+
+/// G474 single-bank erase page and programming unit.
+const PAGE: usize = 4096;
+const WORD: usize = 8;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FlashError {
+    PowerCut,
+    NotErased,
+    Unaligned,
+    OutOfBounds,
+}
+
+impl NorFlashError for FlashError {
+    fn kind(&self) -> NorFlashErrorKind {
+        match self {
+            FlashError::Unaligned => NorFlashErrorKind::NotAligned,
+            FlashError::OutOfBounds => NorFlashErrorKind::OutOfBounds,
+            _ => NorFlashErrorKind::Other,
+        }
+    }
+}
+
+/// NOR flash in RAM with the G4's rules (erase to 0xFF by page, program whole erased
+/// double words only) and a power budget in byte operations: the byte at which the
+/// budget runs out is left half-done (an interrupted erase or program leaves bits that are
+/// neither old nor new), and every later operation fails.
+struct CutFlash {
+    mem: Vec<u8>,
+    budget: Option<usize>,
+    dead: bool,
+}
+
+impl CutFlash {
+    fn blank(pages: usize) -> CutFlash {
+        CutFlash {
+            mem: vec![0xFF; pages * PAGE],
+            budget: None,
+            dead: false,
+        }
+    }
+
+    /// The same memory after a reboot, with `budget` byte operations before power fails.
+    fn reboot(mem: Vec<u8>, budget: Option<usize>) -> CutFlash {
+        CutFlash {
+            mem,
+            budget,
+            dead: false,
+        }
+    }
+
+    /// Spends one byte operation; false when power fails at this one.
+    fn spend(&mut self) -> bool {
+        match &mut self.budget {
+            Some(0) => {
+                self.dead = true;
+                false
+            }
+            Some(n) => {
+                *n -= 1;
+                true
+            }
+            None => true,
+        }
+    }
+}
+
+impl ErrorType for CutFlash {
+    type Error = FlashError;
+}
+
+impl ReadNorFlash for CutFlash {
+    const READ_SIZE: usize = 1;
+
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), FlashError> {
+        let at = offset as usize;
+        let src = self
+            .mem
+            .get(at..at + bytes.len())
+            .ok_or(FlashError::OutOfBounds)?;
+        bytes.copy_from_slice(src);
+        Ok(())
+    }
+
+    fn capacity(&self) -> usize {
+        self.mem.len()
+    }
+}
+
+impl NorFlash for CutFlash {
+    const WRITE_SIZE: usize = WORD;
+    const ERASE_SIZE: usize = PAGE;
+
+    fn erase(&mut self, from: u32, to: u32) -> Result<(), FlashError> {
+        let (from, to) = (from as usize, to as usize);
+        if from % PAGE != 0 || to % PAGE != 0 || to < from {
+            return Err(FlashError::Unaligned);
+        }
+        if to > self.mem.len() {
+            return Err(FlashError::OutOfBounds);
+        }
+        for i in from..to {
+            if self.dead || !self.spend() {
+                // Half-erased: some bits set, some still as before.
+                self.mem[i] |= 0x5A;
+                return Err(FlashError::PowerCut);
+            }
+            self.mem[i] = 0xFF;
+        }
+        Ok(())
+    }
+
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), FlashError> {
+        let at = offset as usize;
+        if at % WORD != 0 || bytes.len() % WORD != 0 {
+            return Err(FlashError::Unaligned);
+        }
+        if at + bytes.len() > self.mem.len() {
+            return Err(FlashError::OutOfBounds);
+        }
+        if self.mem[at..at + bytes.len()].iter().any(|b| *b != 0xFF) {
+            return Err(FlashError::NotErased);
+        }
+        for (i, b) in bytes.iter().enumerate() {
+            if self.dead || !self.spend() {
+                // Half-programmed: only some of the bits to clear are cleared.
+                self.mem[at + i] &= *b | 0x3C;
+                return Err(FlashError::PowerCut);
+            }
+            self.mem[at + i] = *b;
+        }
+        Ok(())
+    }
+}
+
+fn store(flash: CutFlash) -> ParamStore<CutFlash> {
+    ParamStore::new(flash, 0, PAGE as u32).expect("layout")
+}
+
+/// A table that differs from the defaults in every entry by `k` (valid for small k).
+fn table(k: f32) -> [f32; COUNT] {
+    let mut cfg = Config::nominal();
+    ParamId::SpeedKp.set(&mut cfg, 0.14 + 0.01 * k).unwrap();
+    ParamId::AbsorberPrechargePa
+        .set(&mut cfg, 3e6 + 1e5 * k)
+        .unwrap();
+    ParamId::TelemetryDecimation
+        .set(&mut cfg, 20.0 + k)
+        .unwrap();
+    parameters::snapshot(&cfg)
+}
+
+/// Every power-cut point of a save that follows `before` saves: the reboot loads the
+/// last complete table until the very last byte of the commit word is written, and the
+/// new one from then on; a save after the cut always succeeds. Returns the number of cut
+/// points tried.
+fn cut_everywhere(before: &[[f32; COUNT]]) -> usize {
+    let mut base = store(CutFlash::blank(2));
+    for t in before {
+        base.save(t).unwrap();
+    }
+    let base_mem = base.into_inner().mem;
+    let old = before.last().copied();
+    let new = table(9.0);
+    let total = PAGE + RECORD_LEN + COMMIT_LEN;
+    for cut in 0..=total {
+        let mut s = store(CutFlash::reboot(base_mem.clone(), Some(cut)));
+        let result = s.save(&new);
+        let mem = s.into_inner().mem;
+        let mut rebooted = store(CutFlash::reboot(mem.clone(), None));
+        let (values, outcome) = rebooted.load();
+        if cut < total {
+            assert_eq!(
+                result,
+                Err(StoreError::Flash(FlashError::PowerCut)),
+                "cut {cut}"
+            );
+            assert_eq!(values, old, "cut {cut}: {outcome:?}");
+            if old.is_some() {
+                assert!(matches!(outcome, LoadOutcome::Loaded { .. }), "cut {cut}");
+            }
+        } else {
+            assert!(result.is_ok(), "cut {cut}: {result:?}");
+            assert_eq!(values, Some(new), "cut {cut}");
+        }
+        // The next save works whatever the cut left behind.
+        let again = table(10.0);
+        rebooted.save(&again).unwrap();
+        assert_eq!(rebooted.load().0, Some(again), "save after cut {cut}");
+    }
+    total + 1
+}
+
+#[test]
+fn a_power_cut_anywhere_in_the_first_save_leaves_the_store_blank() {
+    let n = cut_everywhere(&[]);
+    assert_eq!(n, PAGE + RECORD_LEN + COMMIT_LEN + 1);
+}
+
+#[test]
+fn a_power_cut_anywhere_in_a_save_leaves_the_previous_table() {
+    // One table before: the save goes to the blank page B.
+    cut_everywhere(&[table(1.0)]);
+}
+
+#[test]
+fn a_power_cut_while_overwriting_the_older_page_leaves_the_newer_table() {
+    // A holds table 1, B table 2: the save erases A; table 2 must survive.
+    cut_everywhere(&[table(1.0), table(2.0)]);
+}
+
+#[test]
+fn the_newest_of_two_valid_records_wins_and_pages_alternate() {
+    let mut s = store(CutFlash::blank(2));
+    assert_eq!(s.load(), (None, LoadOutcome::Blank));
+    for k in 1..=5u32 {
+        let t = table(k as f32);
+        assert_eq!(s.save(&t), Ok(k));
+        assert_eq!(s.load(), (Some(t), LoadOutcome::Loaded { sequence: k }));
+    }
+    // Sequence 5 went to page A (odd), 4 to page B.
+    let mem = s.into_inner().mem;
+    assert_eq!(u32::from_le_bytes(mem[8..12].try_into().unwrap()), 5);
+    assert_eq!(
+        u32::from_le_bytes(mem[PAGE + 8..PAGE + 12].try_into().unwrap()),
+        4
+    );
+}
+
+/// A record built from the module's layout table, independently of its encoder.
+fn documented_record(version: u16, fingerprint: u32, sequence: u32, values: &[f32]) -> Vec<u8> {
+    let mut r = Vec::new();
+    r.extend_from_slice(b"EHAP");
+    r.extend_from_slice(&version.to_le_bytes());
+    r.extend_from_slice(&(values.len() as u16).to_le_bytes());
+    r.extend_from_slice(&sequence.to_le_bytes());
+    r.extend_from_slice(&fingerprint.to_le_bytes());
+    for v in values {
+        r.extend_from_slice(&v.to_le_bytes());
+    }
+    // The table-driven CRC of the crate: another implementation than the store's.
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(&r);
+    r.extend_from_slice(&crc.to_le_bytes());
+    while r.len() % 8 != 0 {
+        r.push(0xFF);
+    }
+    r.extend_from_slice(b"CMMT");
+    r.extend_from_slice(&sequence.to_le_bytes());
+    r
+}
+
+fn flash_with(page_a: &[u8]) -> CutFlash {
+    let mut f = CutFlash::blank(2);
+    f.mem[..page_a.len()].copy_from_slice(page_a);
+    f
+}
+
+#[test]
+fn the_crc_is_crc32_iso_hdlc() {
+    // The standard check value of CRC-32 over "123456789".
+    assert_eq!(CRC.checksum(b"123456789"), 0xCBF4_3926);
+}
+
+#[test]
+fn a_record_written_to_the_documented_layout_loads() {
+    let t = table(3.0);
+    let rec = documented_record(1, parameters::layout_fingerprint(), 7, &t);
+    assert_eq!(rec.len(), SPAN);
+    let mut s = store(flash_with(&rec));
+    assert_eq!(s.load(), (Some(t), LoadOutcome::Loaded { sequence: 7 }));
+    // And the store writes exactly that layout.
+    let mut w = store(CutFlash::blank(2));
+    w.save(&t).unwrap();
+    let mem = w.into_inner().mem;
+    let rec1 = documented_record(1, parameters::layout_fingerprint(), 1, &t);
+    assert_eq!(&mem[..SPAN], &rec1[..]);
+}
+
+fn boots_to_defaults_with_fault(flash: CutFlash, want: LoadOutcome) {
+    let mut s = store(flash);
+    let (cfg, outcome) = boot_config(&mut s, &Config::nominal());
+    assert_eq!(cfg, Config::nominal());
+    assert_eq!(outcome, BootOutcome::DefaultsAfterInvalid(want));
+    assert!(outcome.is_fault());
+}
+
+#[test]
+fn a_corrupt_record_gives_the_defaults_and_the_fault() {
+    let t = table(3.0);
+    let fp = parameters::layout_fingerprint();
+    // One flipped bit in a value: the CRC no longer matches.
+    let mut rec = documented_record(1, fp, 1, &t);
+    rec[20] ^= 0x01;
+    boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
+    // A record without its commit word (cut between record and commit).
+    let mut rec = documented_record(1, fp, 1, &t);
+    let n = rec.len();
+    rec[n - 8..].fill(0xFF);
+    boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
+    // Garbage in the header.
+    boots_to_defaults_with_fault(flash_with(&[0x12; 64]), LoadOutcome::Corrupt);
+}
+
+#[test]
+fn an_old_version_or_another_table_gives_the_defaults_and_the_fault() {
+    let t = table(3.0);
+    let fp = parameters::layout_fingerprint();
+    let rec = documented_record(0, fp, 1, &t);
+    boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::OtherVersion);
+    let rec = documented_record(1, fp ^ 1, 1, &t);
+    boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::OtherVersion);
+    // A shorter table of an older firmware.
+    let rec = documented_record(1, fp, 1, &t[..COUNT - 1]);
+    boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::OtherVersion);
+}
+
+#[test]
+fn stored_values_out_of_bounds_or_inconsistent_give_the_defaults_and_the_fault() {
+    let fp = parameters::layout_fingerprint();
+    let mut t = table(3.0);
+    t[0] = 1e6; // current.kp_d above 200 V/A, CRC valid
+    let rec = documented_record(1, fp, 1, &t);
+    boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
+    let mut t = table(3.0);
+    t[0] = f32::NAN;
+    let rec = documented_record(1, fp, 1, &t);
+    boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
+}
+
+#[test]
+fn a_blank_store_boots_the_defaults_without_a_fault_and_a_valid_one_its_table() {
+    let mut s = store(CutFlash::blank(2));
+    let (cfg, outcome) = boot_config(&mut s, &Config::nominal());
+    assert_eq!((cfg, outcome), (Config::nominal(), BootOutcome::Defaults));
+    assert!(!outcome.is_fault());
+    let t = table(4.0);
+    s.save(&t).unwrap();
+    let (cfg, outcome) = boot_config(&mut s, &Config::nominal());
+    assert_eq!(outcome, BootOutcome::Stored { sequence: 1 });
+    assert_eq!(cfg.speed.kp, 0.14 + 0.01 * 4.0);
+    assert_eq!(cfg.rates.telemetry_decimation, 24);
+    assert_eq!(parameters::snapshot(&cfg), t);
+}
+
+#[test]
+fn a_corrupt_newer_page_falls_back_to_the_older_valid_one_without_a_fault() {
+    let mut s = store(CutFlash::blank(2));
+    s.save(&table(1.0)).unwrap();
+    s.save(&table(2.0)).unwrap();
+    let mut f = s.into_inner();
+    f.mem[PAGE + 40] ^= 0x80; // page B holds sequence 2
+    let mut s = store(f);
+    assert_eq!(
+        s.load(),
+        (Some(table(1.0)), LoadOutcome::Loaded { sequence: 1 })
+    );
+}
+
+#[test]
+fn misplaced_pages_are_refused() {
+    assert!(matches!(
+        ParamStore::new(CutFlash::blank(2), 8, PAGE as u32),
+        Err(StoreError::Layout)
+    ));
+    assert!(matches!(
+        ParamStore::new(CutFlash::blank(2), 0, 0),
+        Err(StoreError::Layout)
+    ));
+    assert!(matches!(
+        ParamStore::new(CutFlash::blank(2), 0, 2 * PAGE as u32),
+        Err(StoreError::Layout)
+    ));
+}

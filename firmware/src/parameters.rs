@@ -1,0 +1,506 @@
+//! The live parameter table: every loop gain and limit, the pressure-loop schedule's
+//! hydraulic assumptions, the ramp rate, the telemetry decimation and the commissioning
+//! results, each with a stable wire id, a name (the [`Config`] field path), an SI unit and
+//! documented bounds.
+//!
+//! A parameter is read from and written into a [`Config`]; [`ParamId::set`] checks the
+//! value against the parameter's bounds first (so a refusal names the bound), then the
+//! whole configuration with [`Config::validate`] (so cross-field rules such as "the
+//! feedback filter must be at least twice the pressure bandwidth" still hold, and a
+//! refusal names the conflicting field). Defaults are those of [`Config::nominal`].
+//! How a changed value reaches the running loops is the controller's business
+//! ([`crate::Controller`] applies it between control steps, bumplessly).
+//!
+//! Ids are grouped by tens (current loop 1–5, speed loop 10–15, pressure loop 20–25,
+//! hydraulics 30–36, telemetry 40, commissioning results 50–54); an id is never reused for
+//! another meaning. The stored table ([`crate::param_store`]) carries a fingerprint of this
+//! list ([`layout_fingerprint`]), so a firmware with a changed table never loads an old
+//! record as if it matched.
+//!
+//! # Parameter table
+//!
+//! Bounds are inclusive. Values travel on the wire as IEEE-754 `f32` in the unit shown;
+//! `rates.telemetry_decimation` must be a whole number.
+//!
+//! | id | name | unit | min | max | default |
+//! |----|------|------|-----|-----|---------|
+//! | 1 | `current.kp_d` | V/A | 0.01 | 200 | 5.775 |
+//! | 2 | `current.ki_d` | V/(A·s) | 0 | 100000 | 1053.8 |
+//! | 3 | `current.kp_q` | V/A | 0.01 | 200 | 13.2 |
+//! | 4 | `current.ki_q` | V/(A·s) | 0 | 100000 | 1053.8 |
+//! | 5 | `current.voltage_limit_v` | V | 1 | 250 | 161.6 |
+//! | 10 | `speed.kp` | A/(rad/s) | 0.0001 | 10 | 0.14 |
+//! | 11 | `speed.ki` | A/rad | 0 | 1000 | 7 |
+//! | 12 | `speed.active_damping` | A/(rad/s) | 0 | 1 | 0.013 |
+//! | 13 | `speed.iq_limit_a` | A | 0.1 | 100 | 30 |
+//! | 14 | `speed.speed_limit_rad_s` | rad/s | 1 | 1000 | 200 |
+//! | 15 | `speed.observer_bandwidth_rad_s` | rad/s | 10 | 5000 | 1000 |
+//! | 20 | `pressure.bandwidth_rad_s` | rad/s | 0.1 | 200 | 20 |
+//! | 21 | `pressure.integral_corner_ratio` | 1 | 0 | 1 | 0.25 |
+//! | 22 | `pressure.feedback_filter_rad_s` | rad/s | 1 | 5000 | 150 |
+//! | 23 | `pressure.ramp_pa_per_s` | Pa/s | 1000 | 1000000000 | 10000000 |
+//! | 24 | `pressure.setpoint_min_pa` | Pa | 0 | 25000000 | 0 |
+//! | 25 | `pressure.setpoint_max_pa` | Pa | 100000 | 25000000 | 18000000 |
+//! | 30 | `hydraulics.pump_displacement_m3_per_rev` | m³/rev | 1e-8 | 0.0001 | 0.0000015 |
+//! | 31 | `hydraulics.oil_volume_m3` | m³ | 0.000001 | 0.01 | 0.00045 |
+//! | 32 | `hydraulics.bulk_modulus_pa` | Pa | 100000000 | 2500000000 | 650000000 |
+//! | 33 | `hydraulics.absorber_volume_m3` | m³ | 0 | 0.01 | 0.0004 |
+//! | 34 | `hydraulics.absorber_precharge_pa` | Pa | 0 | 25000000 | 3000000 |
+//! | 35 | `hydraulics.polytropic_exponent` | 1 | 1 | 2 | 1.3 |
+//! | 36 | `hydraulics.leakage_m3_per_s_pa` | (m³/s)/Pa | 0 | 1e-9 | 3e-13 |
+//! | 40 | `rates.telemetry_decimation` | 1 | 1 | 10000 | 20 |
+//! | 50 | `motor.stator_resistance_ohm` | Ω | 0.001 | 100 | 0.958 |
+//! | 51 | `motor.d_inductance_h` | H | 0.000001 | 1 | 0.00525 |
+//! | 52 | `motor.q_inductance_h` | H | 0.000001 | 1 | 0.012 |
+//! | 53 | `motor.flux_linkage_wb` | Wb | 0 | 5 | 0.1827 |
+//! | 54 | `sensors.encoder_offset_rad` | rad | 0 | 6.2831855 | 0 |
+//!
+//! The table above is checked against the code by this module's tests.
+
+use crate::config::Config;
+use core::fmt;
+
+/// Number of parameters in the table.
+pub const COUNT: usize = 30;
+
+/// A parameter of the live table; the discriminant is the wire id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum ParamId {
+    /// d-axis current PI proportional gain `current.kp_d`. [V/A]
+    CurrentKpD = 1,
+    /// d-axis current PI integral gain `current.ki_d`. [V/(A·s)]
+    CurrentKiD = 2,
+    /// q-axis current PI proportional gain `current.kp_q`. [V/A]
+    CurrentKpQ = 3,
+    /// q-axis current PI integral gain `current.ki_q`. [V/(A·s)]
+    CurrentKiQ = 4,
+    /// Output limit of each current PI `current.voltage_limit_v`. [V]
+    CurrentVoltageLimit = 5,
+    /// Speed PI proportional gain `speed.kp`. [A/(rad/s)]
+    SpeedKp = 10,
+    /// Speed PI integral gain `speed.ki`. [A/rad]
+    SpeedKi = 11,
+    /// Active damping Ba `speed.active_damping`. [A/(rad/s)]
+    SpeedActiveDamping = 12,
+    /// q-current reference limit `speed.iq_limit_a`. [A]
+    SpeedIqLimit = 13,
+    /// Speed reference limit `speed.speed_limit_rad_s`. [rad/s]
+    SpeedLimit = 14,
+    /// Speed observer bandwidth `speed.observer_bandwidth_rad_s`. [rad/s]
+    SpeedObserverBandwidth = 15,
+    /// Pressure-loop crossover `pressure.bandwidth_rad_s`. [rad/s]
+    PressureBandwidth = 20,
+    /// PI corner as a fraction of the crossover `pressure.integral_corner_ratio`. [1]
+    PressureIntegralCornerRatio = 21,
+    /// Pressure feedback low-pass corner `pressure.feedback_filter_rad_s`. [rad/s]
+    PressureFeedbackFilter = 22,
+    /// Pressure setpoint ramp rate `pressure.ramp_pa_per_s`. [Pa/s]
+    PressureRamp = 23,
+    /// Smallest pressure setpoint `pressure.setpoint_min_pa`. [Pa]
+    PressureSetpointMin = 24,
+    /// Largest pressure setpoint `pressure.setpoint_max_pa`. [Pa]
+    PressureSetpointMax = 25,
+    /// Pump displacement `hydraulics.pump_displacement_m3_per_rev`. [m³/rev]
+    PumpDisplacement = 30,
+    /// High-side oil volume `hydraulics.oil_volume_m3`. [m³]
+    OilVolume = 31,
+    /// Oil bulk modulus `hydraulics.bulk_modulus_pa`. [Pa]
+    BulkModulus = 32,
+    /// Absorber shell volume `hydraulics.absorber_volume_m3`. [m³]
+    AbsorberVolume = 33,
+    /// Absorber gas precharge (gauge) `hydraulics.absorber_precharge_pa`. [Pa]
+    AbsorberPrechargePa = 34,
+    /// Gas polytropic exponent `hydraulics.polytropic_exponent`. [1]
+    PolytropicExponent = 35,
+    /// Leakage conductance `hydraulics.leakage_m3_per_s_pa`. [(m³/s)/Pa]
+    Leakage = 36,
+    /// PWM periods per telemetry frame `rates.telemetry_decimation`. [1]
+    TelemetryDecimation = 40,
+    /// Commissioned stator resistance `motor.stator_resistance_ohm`. [Ω]
+    StatorResistance = 50,
+    /// Commissioned d-axis inductance `motor.d_inductance_h`. [H]
+    DInductance = 51,
+    /// Commissioned q-axis inductance `motor.q_inductance_h`. [H]
+    QInductance = 52,
+    /// Commissioned flux linkage `motor.flux_linkage_wb`. [Wb]
+    FluxLinkage = 53,
+    /// Commissioned encoder electrical offset `sensors.encoder_offset_rad`. [rad]
+    EncoderOffset = 54,
+}
+
+/// Name, unit and bounds of one parameter.
+struct Spec {
+    name: &'static str,
+    unit: &'static str,
+    min: f32,
+    max: f32,
+}
+
+const fn spec(name: &'static str, unit: &'static str, min: f32, max: f32) -> Spec {
+    Spec {
+        name,
+        unit,
+        min,
+        max,
+    }
+}
+
+impl ParamId {
+    /// Every parameter, in wire-id order (also the order of the stored record).
+    pub const ALL: [ParamId; COUNT] = [
+        ParamId::CurrentKpD,
+        ParamId::CurrentKiD,
+        ParamId::CurrentKpQ,
+        ParamId::CurrentKiQ,
+        ParamId::CurrentVoltageLimit,
+        ParamId::SpeedKp,
+        ParamId::SpeedKi,
+        ParamId::SpeedActiveDamping,
+        ParamId::SpeedIqLimit,
+        ParamId::SpeedLimit,
+        ParamId::SpeedObserverBandwidth,
+        ParamId::PressureBandwidth,
+        ParamId::PressureIntegralCornerRatio,
+        ParamId::PressureFeedbackFilter,
+        ParamId::PressureRamp,
+        ParamId::PressureSetpointMin,
+        ParamId::PressureSetpointMax,
+        ParamId::PumpDisplacement,
+        ParamId::OilVolume,
+        ParamId::BulkModulus,
+        ParamId::AbsorberVolume,
+        ParamId::AbsorberPrechargePa,
+        ParamId::PolytropicExponent,
+        ParamId::Leakage,
+        ParamId::TelemetryDecimation,
+        ParamId::StatorResistance,
+        ParamId::DInductance,
+        ParamId::QInductance,
+        ParamId::FluxLinkage,
+        ParamId::EncoderOffset,
+    ];
+
+    fn spec(self) -> Spec {
+        use ParamId::*;
+        match self {
+            CurrentKpD => spec("current.kp_d", "V/A", 0.01, 200.0),
+            CurrentKiD => spec("current.ki_d", "V/(A·s)", 0.0, 1e5),
+            CurrentKpQ => spec("current.kp_q", "V/A", 0.01, 200.0),
+            CurrentKiQ => spec("current.ki_q", "V/(A·s)", 0.0, 1e5),
+            CurrentVoltageLimit => spec("current.voltage_limit_v", "V", 1.0, 250.0),
+            SpeedKp => spec("speed.kp", "A/(rad/s)", 1e-4, 10.0),
+            SpeedKi => spec("speed.ki", "A/rad", 0.0, 1000.0),
+            SpeedActiveDamping => spec("speed.active_damping", "A/(rad/s)", 0.0, 1.0),
+            SpeedIqLimit => spec("speed.iq_limit_a", "A", 0.1, 100.0),
+            SpeedLimit => spec("speed.speed_limit_rad_s", "rad/s", 1.0, 1000.0),
+            SpeedObserverBandwidth => spec("speed.observer_bandwidth_rad_s", "rad/s", 10.0, 5000.0),
+            PressureBandwidth => spec("pressure.bandwidth_rad_s", "rad/s", 0.1, 200.0),
+            PressureIntegralCornerRatio => spec("pressure.integral_corner_ratio", "1", 0.0, 1.0),
+            PressureFeedbackFilter => spec("pressure.feedback_filter_rad_s", "rad/s", 1.0, 5000.0),
+            PressureRamp => spec("pressure.ramp_pa_per_s", "Pa/s", 1e3, 1e9),
+            PressureSetpointMin => spec("pressure.setpoint_min_pa", "Pa", 0.0, 25e6),
+            PressureSetpointMax => spec("pressure.setpoint_max_pa", "Pa", 1e5, 25e6),
+            PumpDisplacement => spec(
+                "hydraulics.pump_displacement_m3_per_rev",
+                "m³/rev",
+                1e-8,
+                1e-4,
+            ),
+            OilVolume => spec("hydraulics.oil_volume_m3", "m³", 1e-6, 1e-2),
+            BulkModulus => spec("hydraulics.bulk_modulus_pa", "Pa", 1e8, 2.5e9),
+            AbsorberVolume => spec("hydraulics.absorber_volume_m3", "m³", 0.0, 1e-2),
+            AbsorberPrechargePa => spec("hydraulics.absorber_precharge_pa", "Pa", 0.0, 25e6),
+            PolytropicExponent => spec("hydraulics.polytropic_exponent", "1", 1.0, 2.0),
+            Leakage => spec("hydraulics.leakage_m3_per_s_pa", "(m³/s)/Pa", 0.0, 1e-9),
+            TelemetryDecimation => spec("rates.telemetry_decimation", "1", 1.0, 10_000.0),
+            StatorResistance => spec("motor.stator_resistance_ohm", "Ω", 1e-3, 100.0),
+            DInductance => spec("motor.d_inductance_h", "H", 1e-6, 1.0),
+            QInductance => spec("motor.q_inductance_h", "H", 1e-6, 1.0),
+            FluxLinkage => spec("motor.flux_linkage_wb", "Wb", 0.0, 5.0),
+            EncoderOffset => spec(
+                "sensors.encoder_offset_rad",
+                "rad",
+                0.0,
+                core::f32::consts::TAU,
+            ),
+        }
+    }
+
+    /// Wire id.
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// From a wire id.
+    pub fn from_code(code: u8) -> Option<ParamId> {
+        ParamId::ALL.iter().copied().find(|p| p.code() == code)
+    }
+
+    /// Name: the dotted [`Config`] field path, e.g. `speed.kp`.
+    pub fn name(self) -> &'static str {
+        self.spec().name
+    }
+
+    /// From a name as returned by [`ParamId::name`].
+    pub fn from_name(name: &str) -> Option<ParamId> {
+        ParamId::ALL.iter().copied().find(|p| p.name() == name)
+    }
+
+    /// SI unit, as written in the table.
+    pub fn unit(self) -> &'static str {
+        self.spec().unit
+    }
+
+    /// Smallest accepted value. [unit]
+    pub fn min(self) -> f32 {
+        self.spec().min
+    }
+
+    /// Largest accepted value. [unit]
+    pub fn max(self) -> f32 {
+        self.spec().max
+    }
+
+    /// True for a parameter that takes whole numbers only.
+    pub fn is_integer(self) -> bool {
+        self == ParamId::TelemetryDecimation
+    }
+
+    /// Default: the value in [`Config::nominal`]. [unit]
+    pub fn default_value(self) -> f32 {
+        self.get(&Config::nominal())
+    }
+
+    /// The value in `cfg`. [unit]
+    pub fn get(self, cfg: &Config) -> f32 {
+        use ParamId::*;
+        match self {
+            CurrentKpD => cfg.current.kp_d,
+            CurrentKiD => cfg.current.ki_d,
+            CurrentKpQ => cfg.current.kp_q,
+            CurrentKiQ => cfg.current.ki_q,
+            CurrentVoltageLimit => cfg.current.voltage_limit_v,
+            SpeedKp => cfg.speed.kp,
+            SpeedKi => cfg.speed.ki,
+            SpeedActiveDamping => cfg.speed.active_damping,
+            SpeedIqLimit => cfg.speed.iq_limit_a,
+            SpeedLimit => cfg.speed.speed_limit_rad_s,
+            SpeedObserverBandwidth => cfg.speed.observer_bandwidth_rad_s,
+            PressureBandwidth => cfg.pressure.bandwidth_rad_s,
+            PressureIntegralCornerRatio => cfg.pressure.integral_corner_ratio,
+            PressureFeedbackFilter => cfg.pressure.feedback_filter_rad_s,
+            PressureRamp => cfg.pressure.ramp_pa_per_s,
+            PressureSetpointMin => cfg.pressure.setpoint_min_pa,
+            PressureSetpointMax => cfg.pressure.setpoint_max_pa,
+            PumpDisplacement => cfg.hydraulics.pump_displacement_m3_per_rev,
+            OilVolume => cfg.hydraulics.oil_volume_m3,
+            BulkModulus => cfg.hydraulics.bulk_modulus_pa,
+            AbsorberVolume => cfg.hydraulics.absorber_volume_m3,
+            AbsorberPrechargePa => cfg.hydraulics.absorber_precharge_pa,
+            PolytropicExponent => cfg.hydraulics.polytropic_exponent,
+            Leakage => cfg.hydraulics.leakage_m3_per_s_pa,
+            // Validated to at most 10 000, exact in f32.
+            TelemetryDecimation => cfg.rates.telemetry_decimation as f32,
+            StatorResistance => cfg.motor.stator_resistance_ohm,
+            DInductance => cfg.motor.d_inductance_h,
+            QInductance => cfg.motor.q_inductance_h,
+            FluxLinkage => cfg.motor.flux_linkage_wb,
+            EncoderOffset => cfg.sensors.encoder_offset_rad,
+        }
+    }
+
+    /// Writes `value` into `cfg` without any check (see [`ParamId::set`]).
+    fn write(self, cfg: &mut Config, value: f32) {
+        use ParamId::*;
+        let slot = match self {
+            CurrentKpD => &mut cfg.current.kp_d,
+            CurrentKiD => &mut cfg.current.ki_d,
+            CurrentKpQ => &mut cfg.current.kp_q,
+            CurrentKiQ => &mut cfg.current.ki_q,
+            CurrentVoltageLimit => &mut cfg.current.voltage_limit_v,
+            SpeedKp => &mut cfg.speed.kp,
+            SpeedKi => &mut cfg.speed.ki,
+            SpeedActiveDamping => &mut cfg.speed.active_damping,
+            SpeedIqLimit => &mut cfg.speed.iq_limit_a,
+            SpeedLimit => &mut cfg.speed.speed_limit_rad_s,
+            SpeedObserverBandwidth => &mut cfg.speed.observer_bandwidth_rad_s,
+            PressureBandwidth => &mut cfg.pressure.bandwidth_rad_s,
+            PressureIntegralCornerRatio => &mut cfg.pressure.integral_corner_ratio,
+            PressureFeedbackFilter => &mut cfg.pressure.feedback_filter_rad_s,
+            PressureRamp => &mut cfg.pressure.ramp_pa_per_s,
+            PressureSetpointMin => &mut cfg.pressure.setpoint_min_pa,
+            PressureSetpointMax => &mut cfg.pressure.setpoint_max_pa,
+            PumpDisplacement => &mut cfg.hydraulics.pump_displacement_m3_per_rev,
+            OilVolume => &mut cfg.hydraulics.oil_volume_m3,
+            BulkModulus => &mut cfg.hydraulics.bulk_modulus_pa,
+            AbsorberVolume => &mut cfg.hydraulics.absorber_volume_m3,
+            AbsorberPrechargePa => &mut cfg.hydraulics.absorber_precharge_pa,
+            PolytropicExponent => &mut cfg.hydraulics.polytropic_exponent,
+            Leakage => &mut cfg.hydraulics.leakage_m3_per_s_pa,
+            TelemetryDecimation => {
+                // Checked to be a whole number within 1..=10 000 before this is reached.
+                cfg.rates.telemetry_decimation = value as u32;
+                return;
+            }
+            StatorResistance => &mut cfg.motor.stator_resistance_ohm,
+            DInductance => &mut cfg.motor.d_inductance_h,
+            QInductance => &mut cfg.motor.q_inductance_h,
+            FluxLinkage => &mut cfg.motor.flux_linkage_wb,
+            EncoderOffset => &mut cfg.sensors.encoder_offset_rad,
+        };
+        *slot = value;
+    }
+
+    /// Checks `value` against this parameter's own bounds (not the rest of a
+    /// configuration).
+    pub fn check(self, value: f32) -> Result<(), ParamError> {
+        let s = self.spec();
+        if value.is_nan() {
+            Err(ParamError::NotANumber { id: self })
+        } else if value < s.min {
+            Err(ParamError::BelowMinimum {
+                id: self,
+                min: s.min,
+            })
+        } else if value > s.max {
+            Err(ParamError::AboveMaximum {
+                id: self,
+                max: s.max,
+            })
+        } else if self.is_integer() && libm::truncf(value) != value {
+            Err(ParamError::NotWhole { id: self })
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Sets the parameter in `cfg` if the value is within its bounds and the resulting
+    /// configuration validates; otherwise `cfg` is left as it was.
+    pub fn set(self, cfg: &mut Config, value: f32) -> Result<(), ParamError> {
+        self.check(value)?;
+        let mut next = *cfg;
+        self.write(&mut next, value);
+        next.validate().map_err(|e| ParamError::Inconsistent {
+            id: self,
+            field: e.field,
+            problem: e.problem,
+        })?;
+        *cfg = next;
+        Ok(())
+    }
+}
+
+impl fmt::Display for ParamId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} (id {})", self.name(), self.code())
+    }
+}
+
+/// Why a parameter value was refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamError {
+    /// Below the parameter's minimum.
+    BelowMinimum {
+        /// The parameter.
+        id: ParamId,
+        /// Its minimum. [unit]
+        min: f32,
+    },
+    /// Above the parameter's maximum.
+    AboveMaximum {
+        /// The parameter.
+        id: ParamId,
+        /// Its maximum. [unit]
+        max: f32,
+    },
+    /// Not a number.
+    NotANumber {
+        /// The parameter.
+        id: ParamId,
+    },
+    /// A whole-number parameter given a fraction.
+    NotWhole {
+        /// The parameter.
+        id: ParamId,
+    },
+    /// Within its bounds, but the configuration with it fails validation.
+    Inconsistent {
+        /// The parameter.
+        id: ParamId,
+        /// The configuration field [`Config::validate`] named.
+        field: &'static str,
+        /// What is wrong with it.
+        problem: &'static str,
+    },
+}
+
+impl ParamError {
+    /// The refused parameter.
+    pub fn id(&self) -> ParamId {
+        match *self {
+            ParamError::BelowMinimum { id, .. }
+            | ParamError::AboveMaximum { id, .. }
+            | ParamError::NotANumber { id }
+            | ParamError::NotWhole { id }
+            | ParamError::Inconsistent { id, .. } => id,
+        }
+    }
+}
+
+impl fmt::Display for ParamError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ParamError::BelowMinimum { id, min } => {
+                write!(f, "{id}: below its minimum {min} {}", id.unit())
+            }
+            ParamError::AboveMaximum { id, max } => {
+                write!(f, "{id}: above its maximum {max} {}", id.unit())
+            }
+            ParamError::NotANumber { id } => write!(f, "{id}: not a number"),
+            ParamError::NotWhole { id } => write!(f, "{id}: must be a whole number"),
+            ParamError::Inconsistent { id, field, problem } => {
+                write!(f, "{id}: refused, config field `{field}` {problem}")
+            }
+        }
+    }
+}
+
+/// All parameter values of `cfg`, in [`ParamId::ALL`] order.
+pub fn snapshot(cfg: &Config) -> [f32; COUNT] {
+    ParamId::ALL.map(|p| p.get(cfg))
+}
+
+/// Writes every value of `values` (in [`ParamId::ALL`] order) into `cfg` after checking
+/// each against its bounds and the result with [`Config::validate`]; on any refusal `cfg`
+/// is left as it was. Used at boot for a stored table, whose values may be individually
+/// valid and only consistent together.
+pub fn apply_all(cfg: &mut Config, values: &[f32; COUNT]) -> Result<(), ParamError> {
+    let mut next = *cfg;
+    for (p, v) in ParamId::ALL.iter().zip(values) {
+        p.check(*v)?;
+        p.write(&mut next, *v);
+    }
+    next.validate().map_err(|e| ParamError::Inconsistent {
+        // The first parameter whose field the validator named, else the first one.
+        id: ParamId::from_name(e.field).unwrap_or(ParamId::CurrentKpD),
+        field: e.field,
+        problem: e.problem,
+    })?;
+    *cfg = next;
+    Ok(())
+}
+
+/// CRC-32 of the table's ids and names in order: changes whenever a parameter is added,
+/// removed, renumbered or renamed, so a stored record of another table is recognised.
+pub fn layout_fingerprint() -> u32 {
+    let mut digest = crate::param_store::CRC.digest();
+    for p in ParamId::ALL {
+        digest.update(&[p.code()]);
+        digest.update(p.name().as_bytes());
+    }
+    digest.finalize()
+}
+
+#[cfg(test)]
+mod tests;
