@@ -4,7 +4,9 @@
 //! scenario, the noise-free RMS of (with effect − without) over the second half of the log
 //! against the sensor noise's RMS, and the fit gain that would attain, per logged signal.
 //! The specification `floor` instead perturbs the plant by a negligible 1e-20 (m³/s)/Pa of
-//! leakage: what remains is the closed loop's own divergence under quantisation.
+//! leakage: what remains is the closed loop's own divergence under quantisation. `A|B`
+//! compares effect A against effect B instead of against none (e.g. two breakaway levels
+//! of one friction, to see whether the breakaway is observable at all).
 //!
 //! `cargo run --release -p tests --example blind_probe [SPEC …]`
 
@@ -53,16 +55,19 @@ fn main() -> Result<(), String> {
         header.join(" | ")
     );
     for spec in &specs {
-        let effect = if spec == "floor" {
+        let (with, base) = spec.split_once('|').unwrap_or((spec, "none"));
+        let effect = if with == "floor" {
             Effect::ExtraLeakage {
                 coefficient_m3_s_pa: 1e-20,
             }
         } else {
-            Effect::parse(spec).map_err(|e| format!("{spec}: {e}"))?
+            Effect::parse(with).map_err(|e| format!("{with}: {e}"))?
         };
+        let base = Effect::parse(base).map_err(|e| format!("{base}: {e}"))?;
         for sc in SCENARIOS {
             let mut d = draw(1000);
             d.effect = effect;
+            base.apply(&mut d.tolerance_rig);
             d.scenario = *by_name(sc.name).ok_or("scenario")?;
             let t_from = d.scenario.duration_s / 2.0;
             let mut row = format!("| {spec} | {} |", sc.name);

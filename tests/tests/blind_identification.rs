@@ -5,7 +5,9 @@
 //! - name the hidden effect first (`none` first when none was hidden);
 //! - fit each of its parameters within 20 % of the truth — integer parameters (`pistons`,
 //!   `order`) exactly, phases within 0.35 rad modulo 2π (a negative fitted amplitude with
-//!   the phase turned by π is the same harmonic and is normalised first);
+//!   the phase turned by π is the same harmonic and is normalised first); the shaft's
+//!   breakaway torque, which no scenario makes observable
+//!   ([`tests::blind::UNOBSERVABLE_PARAMETERS`]), is shown but not held to it;
 //! - improve the validation-segment fit on the signal where the effect shows most by at
 //!   least 10 points.
 //!
@@ -24,7 +26,9 @@ use rayon::prelude::*;
 use serde_json::Value;
 use std::f64::consts::{PI, TAU};
 use std::path::PathBuf;
-use tests::blind::{draw, generate, signature, Truth, BELOW_NOISE, SUITE_SEEDS};
+use tests::blind::{
+    draw, generate, signature, Truth, BELOW_NOISE, SUITE_SEEDS, UNOBSERVABLE_PARAMETERS,
+};
 
 /// Relative tolerance on a fitted continuous parameter. [1]
 const PARAMETER_TOLERANCE: f64 = 0.2;
@@ -146,6 +150,9 @@ fn parameter_failures(truth: &Truth, fitted: &[(String, f64)]) -> Vec<String> {
     let fitted = normalised(fitted);
     let mut out = Vec::new();
     for (name, t) in &truth_params {
+        if UNOBSERVABLE_PARAMETERS.contains(&(truth.effect_name, name.as_str())) {
+            continue;
+        }
         let t = effective(name, *t, &truth_params);
         let Some((_, f)) = fitted.iter().find(|(k, _)| k == name) else {
             out.push(format!("parameter `{name}` not fitted"));
@@ -313,4 +320,78 @@ fn every_hidden_effect_stands_above_the_sensor_noise() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn the_judge_accepts_the_same_harmonic_and_refuses_a_wrong_parameter() {
+    let truth = Truth {
+        effect_name: "cogging_torque",
+        parameters: vec![("amplitude_nm", 0.1), ("order", 72.0), ("phase_rad", 6.2)],
+        scenario: "pressure-hold",
+        duration_s: 3.0,
+        signal: "iq_a",
+    };
+    let fitted = |a: f64, o: f64, ph: f64| {
+        vec![
+            ("amplitude_nm".to_string(), a),
+            ("order".to_string(), o),
+            ("phase_rad".to_string(), ph),
+        ]
+    };
+    // 6.2 rad and 0.1 rad are 0.183 rad apart across 2π; order 0 is LCM(9, 8) = 72;
+    // −0.11 N·m at phase 6.2 − π is +0.11 N·m at 6.2 (10 % off).
+    assert!(parameter_failures(&truth, &fitted(0.085, 72.0, 0.1)).is_empty());
+    assert!(parameter_failures(&truth, &fitted(0.1, 0.0, 6.2)).is_empty());
+    assert!(parameter_failures(&truth, &fitted(-0.11, 72.0, 6.2 - PI)).is_empty());
+    // 25 % off, order 36, 0.5 rad off, a parameter missing: each refused.
+    assert_eq!(
+        parameter_failures(&truth, &fitted(0.125, 72.0, 6.2)).len(),
+        1
+    );
+    assert_eq!(parameter_failures(&truth, &fitted(0.1, 36.0, 6.2)).len(), 1);
+    assert_eq!(parameter_failures(&truth, &fitted(0.1, 72.0, 5.7)).len(), 1);
+    assert_eq!(
+        parameter_failures(&truth, &fitted(0.1, 72.0, 6.2)[..2]).len(),
+        1
+    );
+    // Kinematic ripple of 9 pistons: (π/18)·tan(π/36) = 1.527 %; `amplitude_ratio = 0` is it.
+    let ripple = Truth {
+        effect_name: "piston_ripple",
+        parameters: vec![("pistons", 9.0), ("amplitude_ratio", 0.01527)],
+        ..truth
+    };
+    let said = vec![
+        ("pistons".to_string(), 9.0),
+        ("amplitude_ratio".to_string(), 0.0),
+    ];
+    assert!(parameter_failures(&ripple, &said).is_empty());
+}
+
+#[test]
+fn the_log_tells_nothing_but_its_source() {
+    for seed in [5, 9] {
+        let (path, truth) = generate(seed, &log_dir()).expect("generate");
+        let log = bench_log::read(&path).expect("the generated log reads back");
+        assert_eq!(
+            log.metadata,
+            vec![("source".to_string(), "blind-suite".to_string())]
+        );
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        // `blind-` and 16 hex digits drawn from the stream: no seed, no effect name.
+        let token = name
+            .strip_prefix("blind-")
+            .and_then(|n| n.strip_suffix(".csv"));
+        assert!(
+            token.is_some_and(|t| t.len() == 16 && t.chars().all(|c| c.is_ascii_hexdigit())),
+            "{name}"
+        );
+        // 1 kHz for the drawn length, every required and simulated column present.
+        let rows = (truth.duration_s * 1e3).ceil() as usize;
+        assert!(
+            log.len().abs_diff(rows) <= 1,
+            "{} rows, {rows} expected",
+            log.len()
+        );
+        assert!(log.ud_v.is_some() && log.uq_v.is_some() && log.theta_m_rad.is_some());
+    }
 }
