@@ -5,6 +5,8 @@
 //! quantity's unit) and is defined the textbook way, so a test's expected numbers come from
 //! the design formulas, not from this code.
 
+pub mod blind;
+
 use closed_loop::{controller_config, ClosedLoop, Sample, Scenario};
 use plant_model::Rig;
 

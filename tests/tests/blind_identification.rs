@@ -1,0 +1,397 @@
+//! The blind identification suite (issue 5): over [`SUITE_SEEDS`] seeds the generator
+//! ([`tests::blind`]) hides one catalogue effect or none in a closed-loop bench log of a
+//! tolerance-perturbed rig; the diagnosis (`host_sim::diagnose::diagnose`) gets only the log
+//! read back from its CSV file and the NOMINAL rig, and must
+//! - name the hidden effect first (`none` first when none was hidden);
+//! - fit each of its parameters within 20 % of the truth — integer parameters (`pistons`,
+//!   `order`) exactly, phases within 0.35 rad modulo 2π (a negative fitted amplitude with
+//!   the phase turned by π is the same harmonic and is normalised first); the shaft's
+//!   breakaway torque, which no scenario makes observable
+//!   ([`tests::blind::UNOBSERVABLE_PARAMETERS`]), is shown but not held to it;
+//! - improve the validation-segment fit on the signal where the effect shows most by at
+//!   least 10 points.
+//!
+//! The diagnosis is read only through the contract's JSON (`shared/contracts/eha-cli.md`):
+//! the suite depends on the contract, not on the diagnosis's Rust types. The truth numbers
+//! come from the generator's draw, never from the diagnosis.
+//!
+//! A second test checks the generator itself, independently of the diagnosis: every hidden
+//! effect's noise-free signature on its signal stands above the sensor noise.
+
+use host_sim::bench_log;
+use host_sim::diagnose::diagnose;
+use plant_model::pump::kinematic_ripple_ratio;
+use plant_model::Rig;
+use rayon::prelude::*;
+use serde_json::Value;
+use std::f64::consts::{PI, TAU};
+use std::path::PathBuf;
+use tests::blind::{
+    draw, generate, signature, Truth, BELOW_NOISE, SUITE_SEEDS, UNOBSERVABLE_PARAMETERS,
+};
+
+/// Relative tolerance on a fitted continuous parameter. [1]
+const PARAMETER_TOLERANCE: f64 = 0.2;
+/// Tolerance on a fitted phase, modulo 2π. [rad]
+const PHASE_TOLERANCE_RAD: f64 = 0.35;
+/// Least validation-fit gain on the truth's signal when an effect was hidden. [points]
+const MIN_FIT_GAIN: f64 = 10.0;
+
+/// Where the generated logs go.
+fn log_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("blind");
+    std::fs::create_dir_all(&dir).expect("create the blind-log directory");
+    dir
+}
+
+/// What the diagnosis said about one log, read from its contract JSON.
+struct Said {
+    /// `causes[0].effect`.
+    effect: String,
+    /// `causes[0].parameters`.
+    parameters: Vec<(String, f64)>,
+    /// `baseline.fit_percent_by_signal[signal]`. [%]
+    baseline_fit: Option<f64>,
+    /// `extended.fit_percent_by_signal[signal]`. [%]
+    extended_fit: Option<f64>,
+}
+
+fn read_said(json: &Value, signal: &str) -> Result<Said, String> {
+    let first = json
+        .pointer("/causes/0")
+        .ok_or("the diagnosis names no cause (`causes` is empty)")?;
+    let effect = first
+        .get("effect")
+        .and_then(Value::as_str)
+        .ok_or("`causes[0].effect` is not a string")?
+        .to_string();
+    let parameters = first
+        .get("parameters")
+        .and_then(Value::as_object)
+        .map(|m| {
+            m.iter()
+                .filter_map(|(k, v)| v.as_f64().map(|v| (k.clone(), v)))
+                .collect()
+        })
+        .unwrap_or_default();
+    let fit = |model: &str| {
+        json.pointer(&format!("/{model}/fit_percent_by_signal/{signal}"))
+            .and_then(Value::as_f64)
+    };
+    Ok(Said {
+        effect,
+        parameters,
+        baseline_fit: fit("baseline"),
+        extended_fit: fit("extended"),
+    })
+}
+
+/// Generates, reads back and diagnoses one seed.
+fn run_seed(seed: u64) -> (Truth, Result<Said, String>) {
+    let (path, truth) = match generate(seed, &log_dir()) {
+        Ok(g) => g,
+        Err(e) => panic!("seed {seed}: the generator failed: {e}"),
+    };
+    let said = bench_log::read(&path)
+        .map_err(|e| format!("reading back the generated log: {e}"))
+        .and_then(|log| {
+            diagnose(&log, &Rig::nominal()).map_err(|e| format!("diagnose failed: {e}"))
+        })
+        .and_then(|d| serde_json::to_value(&d).map_err(|e| format!("to JSON: {e}")))
+        .and_then(|json| read_said(&json, truth.signal));
+    (truth, said)
+}
+
+/// A parameter's value as the plant understands it: `amplitude_ratio = 0` is the kinematic
+/// ripple of the pistons, `order = 0` the cogging fundamental LCM(slots, 2·pole pairs).
+fn effective(name: &str, value: f64, params: &[(String, f64)]) -> f64 {
+    match (name, value) {
+        ("amplitude_ratio", 0.0) => {
+            let z = params
+                .iter()
+                .find(|(k, _)| k == "pistons")
+                .map_or(0.0, |(_, z)| *z);
+            kinematic_ripple_ratio(z as u32)
+        }
+        ("order", 0.0) => Rig::nominal().motor.cogging_fundamental_order() as f64,
+        (_, v) => v,
+    }
+}
+
+/// The fitted parameters with a negative harmonic amplitude turned positive and its phase
+/// by π (the same harmonic).
+fn normalised(params: &[(String, f64)]) -> Vec<(String, f64)> {
+    let flip = params
+        .iter()
+        .any(|(k, v)| (k == "amplitude_nm" || k == "t6_ratio") && *v < 0.0);
+    params
+        .iter()
+        .map(|(k, v)| match k.as_str() {
+            "amplitude_nm" | "t6_ratio" if flip => (k.clone(), -v),
+            "phase_rad" if flip => (k.clone(), v + PI),
+            _ => (k.clone(), *v),
+        })
+        .collect()
+}
+
+/// Distance of two angles modulo 2π. [rad]
+fn angle_distance(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(TAU);
+    d.min(TAU - d)
+}
+
+/// Each truth parameter against the fitted one; the failures, described.
+fn parameter_failures(truth: &Truth, fitted: &[(String, f64)]) -> Vec<String> {
+    let truth_params: Vec<(String, f64)> = truth
+        .parameters
+        .iter()
+        .map(|(k, v)| (k.to_string(), *v))
+        .collect();
+    let fitted = normalised(fitted);
+    let mut out = Vec::new();
+    for (name, t) in &truth_params {
+        if UNOBSERVABLE_PARAMETERS.contains(&(truth.effect_name, name.as_str())) {
+            continue;
+        }
+        let t = effective(name, *t, &truth_params);
+        let Some((_, f)) = fitted.iter().find(|(k, _)| k == name) else {
+            out.push(format!("parameter `{name}` not fitted"));
+            continue;
+        };
+        let f = effective(name, *f, &fitted);
+        let ok = match name.as_str() {
+            "pistons" | "order" => f == t,
+            "phase_rad" => angle_distance(f, t) <= PHASE_TOLERANCE_RAD,
+            _ => (f - t).abs() <= PARAMETER_TOLERANCE * t.abs(),
+        };
+        if !ok {
+            out.push(format!("`{name}` fitted {f:.4e}, truth {t:.4e}"));
+        }
+    }
+    out
+}
+
+fn show_params(p: &[(String, f64)]) -> String {
+    if p.is_empty() {
+        return "—".into();
+    }
+    p.iter()
+        .map(|(k, v)| format!("{k}={v:.3e}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn show_fit(f: Option<f64>) -> String {
+    f.map_or("—".into(), |f| format!("{f:.1}"))
+}
+
+#[test]
+fn the_diagnosis_finds_every_hidden_effect() {
+    let results: Vec<(u64, Truth, Result<Said, String>)> = (0..SUITE_SEEDS)
+        .into_par_iter()
+        .map(|seed| {
+            let (truth, said) = run_seed(seed);
+            (seed, truth, said)
+        })
+        .collect();
+
+    println!(
+        "| seed | hidden effect | scenario | signal | truth parameters | named | fitted parameters | baseline fit [%] | extended fit [%] | gain [points] | verdict |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    let mut failures = Vec::new();
+    for (seed, truth, said) in &results {
+        let truth_params: Vec<(String, f64)> = truth
+            .parameters
+            .iter()
+            .map(|(k, v)| (k.to_string(), *v))
+            .collect();
+        let mut wrong = Vec::new();
+        let (named, fitted, base, ext) = match said {
+            Err(e) => {
+                wrong.push(e.clone());
+                ("—".to_string(), "—".to_string(), None, None)
+            }
+            Ok(s) => {
+                if s.effect != truth.effect_name {
+                    wrong.push(format!("named `{}`", s.effect));
+                } else {
+                    wrong.extend(parameter_failures(truth, &s.parameters));
+                }
+                if truth.effect_name != "none" {
+                    match (s.baseline_fit, s.extended_fit) {
+                        (Some(b), Some(e)) if e - b >= MIN_FIT_GAIN => {}
+                        (Some(b), Some(e)) => wrong.push(format!(
+                            "fit gain on {} is {:.1} points < {MIN_FIT_GAIN}",
+                            truth.signal,
+                            e - b
+                        )),
+                        _ => wrong.push(format!("no fit reported for {}", truth.signal)),
+                    }
+                }
+                (
+                    s.effect.clone(),
+                    show_params(&s.parameters),
+                    s.baseline_fit,
+                    s.extended_fit,
+                )
+            }
+        };
+        let gain = match (base, ext) {
+            (Some(b), Some(e)) => format!("{:.1}", e - b),
+            _ => "—".into(),
+        };
+        let verdict = if wrong.is_empty() {
+            "ok".to_string()
+        } else {
+            wrong.join("; ")
+        };
+        println!(
+            "| {seed} | {} | {} | {} | {} | {named} | {fitted} | {} | {} | {gain} | {verdict} |",
+            truth.effect_name,
+            truth.scenario,
+            truth.signal,
+            show_params(&truth_params),
+            show_fit(base),
+            show_fit(ext),
+        );
+        if !wrong.is_empty() {
+            failures.push(format!("seed {seed} ({}): {verdict}", truth.effect_name));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {SUITE_SEEDS} seeds failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn the_suite_covers_every_effect_twice_and_none() {
+    let mut count = std::collections::BTreeMap::new();
+    for seed in 0..SUITE_SEEDS {
+        *count.entry(draw(seed).truth.effect_name).or_insert(0) += 1;
+    }
+    for name in plant_model::effects::EFFECT_NAMES {
+        let n = count.get(name).copied().unwrap_or(0);
+        assert!(
+            n >= 2,
+            "effect {name} drawn {n} times in {SUITE_SEEDS} seeds"
+        );
+    }
+    const { assert!(SUITE_SEEDS >= 30) };
+}
+
+#[test]
+fn every_hidden_effect_stands_above_the_sensor_noise() {
+    let rows: Vec<(u64, Truth, f64, f64)> = (0..SUITE_SEEDS)
+        .into_par_iter()
+        .map(|seed| {
+            let d = draw(seed);
+            let signal = host_sim::bench_log::Signal::from_name(d.truth.signal)
+                .expect("the truth's signal is a bench-log column");
+            // The second half of the log: where a diagnosis would validate.
+            let g = match signature(&d, signal, d.truth.duration_s / 2.0) {
+                Ok(g) => g,
+                Err(e) => panic!("seed {seed}: {e}"),
+            };
+            (seed, d.truth, g.ratio(), g.attainable_fit_gain())
+        })
+        .collect();
+    println!("| seed | effect | scenario | signal | effect RMS / noise RMS | attainable fit gain [points] |");
+    println!("|---|---|---|---|---|---|");
+    let mut failures = Vec::new();
+    for (seed, t, ratio, gain) in &rows {
+        println!(
+            "| {seed} | {} | {} | {} | {ratio:.2} | {gain:.1} |",
+            t.effect_name, t.scenario, t.signal
+        );
+        if t.effect_name == "none" {
+            // Nothing hidden: the truth and the effect-free plant are the same.
+            if *ratio != 0.0 {
+                failures.push(format!("seed {seed}: `none` differs from itself ({ratio})"));
+            }
+        } else if !BELOW_NOISE.contains(&t.effect_name) && *ratio <= 1.0 {
+            failures.push(format!(
+                "seed {seed}: {} in {} shows {ratio:.2}× the noise on {}",
+                t.effect_name, t.scenario, t.signal
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn the_judge_accepts_the_same_harmonic_and_refuses_a_wrong_parameter() {
+    let truth = Truth {
+        effect_name: "cogging_torque",
+        parameters: vec![("amplitude_nm", 0.1), ("order", 72.0), ("phase_rad", 6.2)],
+        scenario: "pressure-hold",
+        duration_s: 3.0,
+        signal: "iq_a",
+    };
+    let fitted = |a: f64, o: f64, ph: f64| {
+        vec![
+            ("amplitude_nm".to_string(), a),
+            ("order".to_string(), o),
+            ("phase_rad".to_string(), ph),
+        ]
+    };
+    // 6.2 rad and 0.1 rad are 0.183 rad apart across 2π; order 0 is LCM(9, 8) = 72;
+    // −0.11 N·m at phase 6.2 − π is +0.11 N·m at 6.2 (10 % off).
+    assert!(parameter_failures(&truth, &fitted(0.085, 72.0, 0.1)).is_empty());
+    assert!(parameter_failures(&truth, &fitted(0.1, 0.0, 6.2)).is_empty());
+    assert!(parameter_failures(&truth, &fitted(-0.11, 72.0, 6.2 - PI)).is_empty());
+    // 25 % off, order 36, 0.5 rad off, a parameter missing: each refused.
+    assert_eq!(
+        parameter_failures(&truth, &fitted(0.125, 72.0, 6.2)).len(),
+        1
+    );
+    assert_eq!(parameter_failures(&truth, &fitted(0.1, 36.0, 6.2)).len(), 1);
+    assert_eq!(parameter_failures(&truth, &fitted(0.1, 72.0, 5.7)).len(), 1);
+    assert_eq!(
+        parameter_failures(&truth, &fitted(0.1, 72.0, 6.2)[..2]).len(),
+        1
+    );
+    // Kinematic ripple of 9 pistons: (π/18)·tan(π/36) = 1.527 %; `amplitude_ratio = 0` is it.
+    let ripple = Truth {
+        effect_name: "piston_ripple",
+        parameters: vec![("pistons", 9.0), ("amplitude_ratio", 0.01527)],
+        ..truth
+    };
+    let said = vec![
+        ("pistons".to_string(), 9.0),
+        ("amplitude_ratio".to_string(), 0.0),
+    ];
+    assert!(parameter_failures(&ripple, &said).is_empty());
+}
+
+#[test]
+fn the_log_tells_nothing_but_its_source() {
+    for seed in [5, 9] {
+        let (path, truth) = generate(seed, &log_dir()).expect("generate");
+        let log = bench_log::read(&path).expect("the generated log reads back");
+        assert_eq!(
+            log.metadata,
+            vec![("source".to_string(), "blind-suite".to_string())]
+        );
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        // `blind-` and 16 hex digits drawn from the stream: no seed, no effect name.
+        let token = name
+            .strip_prefix("blind-")
+            .and_then(|n| n.strip_suffix(".csv"));
+        assert!(
+            token.is_some_and(|t| t.len() == 16 && t.chars().all(|c| c.is_ascii_hexdigit())),
+            "{name}"
+        );
+        // 1 kHz for the drawn length, every required and simulated column present.
+        let rows = (truth.duration_s * 1e3).ceil() as usize;
+        assert!(
+            log.len().abs_diff(rows) <= 1,
+            "{} rows, {rows} expected",
+            log.len()
+        );
+        assert!(log.ud_v.is_some() && log.uq_v.is_some() && log.theta_m_rad.is_some());
+    }
+}
