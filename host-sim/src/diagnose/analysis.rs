@@ -245,7 +245,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
                 .is_some_and(|v| !v.is_empty())
         })
         .collect();
-    let mut fits: Vec<CandidateFit> = usable
+    let fits: Vec<CandidateFit> = usable
         .par_iter()
         .map(|c| {
             let target = Target {
@@ -258,10 +258,38 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             fit(&target, c)
         })
         .collect();
+    // The nominal model within its tolerances, per predictor: the reference every
+    // candidate of that predictor must beat (costs become relative to it).
+    let (calibrations, mut fits): (Vec<CandidateFit>, Vec<CandidateFit>) =
+        fits.into_iter().partition(|f| f.candidate.name == "none");
+    for f in &mut fits {
+        if let Some(c) = calibrations
+            .iter()
+            .find(|c| c.candidate.predictor == f.candidate.predictor)
+        {
+            if c.cost > 0.0 && c.cost < 1.0 {
+                f.cost /= c.cost;
+            }
+        }
+    }
     fits.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-    // 5. Keep the best fault that validates.
+    // 5. Keep the best fault that validates against the calibrated nominal model.
     let val = split..n;
-    let base_val = fits_over(log, &baseline, val.clone());
+    let calibrated_val: BTreeMap<Predictor, BTreeMap<String, f64>> = predictors(log)
+        .into_par_iter()
+        .filter_map(|p| {
+            let calibrated = calibrations
+                .iter()
+                .find(|c| c.candidate.predictor == p)
+                .map_or_else(|| rig.clone(), |c| c.candidate.rig_at(&c.u, rig));
+            let pred: BTreeMap<&'static str, Vec<f64>> =
+                predict(log, &calibrated, p, usize::MAX, 0.0)
+                    .ok()?
+                    .into_iter()
+                    .collect();
+            Some((p, fits_over(log, &pred, val.clone())))
+        })
+        .collect();
     let mut kept: Option<(usize, Predictions)> = None;
     let mut notes: BTreeMap<usize, String> = BTreeMap::new();
     for (i, f) in fits.iter().enumerate() {
@@ -272,16 +300,16 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             notes.insert(i, "within the rig's tolerances".into());
             continue;
         }
-        let mut ext_rig = rig.clone();
-        f.candidate.effect(&f.u, rig).apply(&mut ext_rig);
+        let ext_rig = f.candidate.rig_at(&f.u, rig);
         let ext = predict_all(log, &ext_rig, f.candidate.phase_a_offset_a(&f.u))?;
         let ext_val = fits_over(log, &ext.subsystem, val.clone());
+        let base_val = calibrated_val.get(&f.candidate.predictor);
         let gain = f
             .candidate
             .predictor
             .signals()
             .iter()
-            .filter_map(|s| Some(ext_val.get(*s)? - base_val.get(*s)?))
+            .filter_map(|s| Some(ext_val.get(*s)? - base_val?.get(*s)?))
             .fold(f64::NEG_INFINITY, f64::max);
         if gain >= MIN_VALIDATION_GAIN_POINTS {
             kept = Some((i, ext));
@@ -298,7 +326,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     let describe = |f: &CandidateFit| {
         let signals = f.candidate.predictor.signals().join(", ");
         let mut s = format!(
-            "removes {:.0} % of the nominal model's squared error in {} ({}) on the identification segment",
+            "removes {:.0} % of the squared error the nominal model (within its tolerances) leaves in {} ({}) on the identification segment",
             100.0 * (1.0 - f.cost),
             signals,
             f.candidate.predictor.describe()

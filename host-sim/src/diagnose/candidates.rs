@@ -5,10 +5,24 @@
 //! Each candidate maps a search vector `u` (unbounded, about unit scale) to the effect's
 //! parameters, so one optimiser serves them all: positive quantities are searched in
 //! logarithm (their plausible ranges span decades), signed ones linearly, phases as angles.
+//!
+//! The last coordinate is a tolerance, not a fault: the scale of the quantity that couples
+//! the subsystem's input to its output (the pump's displacement for the hydraulics, the
+//! magnet flux, i.e. the torque constant, for the motor), within a few percent of the rig
+//! file ([`TOLERANCE_STEP`] per unit, clamped to ±[`TOLERANCE_LIMIT`] units). A real rig is
+//! never exactly its rig file; without this coordinate a Coulomb friction would absorb a 3 %
+//! torque-constant error and an air content a 3 % displacement error, and be named. The
+//! `none` candidate fits only this coordinate: the nominal model within its tolerances.
 
 use super::predict::Predictor;
 use plant_model::{Effect, Rig};
 use std::f64::consts::PI;
+
+/// Relative change of the tolerance scale per search unit. [1]
+pub const TOLERANCE_STEP: f64 = 0.02;
+
+/// Largest tolerance excursion, in search units (±5 %). [1]
+pub const TOLERANCE_LIMIT: f64 = 2.5;
 
 /// One candidate effect with its search space.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,6 +72,32 @@ pub fn kinematic_ripple_ratio(z: u32) -> f64 {
 }
 
 impl Candidate {
+    /// Whether the last search coordinate is the tolerance scale.
+    pub fn has_tolerance(&self) -> bool {
+        matches!(self.predictor, Predictor::Hydraulics | Predictor::Motor)
+    }
+
+    /// The tolerance scale at `u` (1 without one). [1]
+    pub fn tolerance_scale(&self, u: &[f64]) -> f64 {
+        match (self.has_tolerance(), u.last()) {
+            (true, Some(t)) => (TOLERANCE_STEP * t.clamp(-TOLERANCE_LIMIT, TOLERANCE_LIMIT)).exp(),
+            _ => 1.0,
+        }
+    }
+
+    /// The rig at search point `u`: `nominal` with the tolerance scale and the effect.
+    pub fn rig_at(&self, u: &[f64], nominal: &Rig) -> Rig {
+        let mut rig = nominal.clone();
+        let k = self.tolerance_scale(u);
+        match self.predictor {
+            Predictor::Hydraulics => rig.pump.displacement_m3_per_rev *= k,
+            Predictor::Motor => rig.motor.psi_f_wb *= k,
+            Predictor::Electrical => {}
+        }
+        self.effect(u, nominal).apply(&mut rig);
+        rig
+    }
+
     /// The effect at search point `u` on `rig`.
     pub fn effect(&self, u: &[f64], rig: &Rig) -> Effect {
         let g = |k: usize| u.get(k).copied().unwrap_or(0.0);
@@ -192,15 +232,27 @@ pub fn candidates(
     piston_moves: bool,
     cogging_orders: &[u32],
 ) -> Vec<Candidate> {
-    let one = |name, predictor, grid: Vec<f64>, dims: usize| Candidate {
-        name,
-        predictor,
-        structure: Structure::None,
-        start: vec![0.0; dims],
-        step: vec![0.5; dims],
-        grid,
+    let one = |name, predictor: Predictor, grid: Vec<f64>, dims: usize| {
+        let tolerance = usize::from(matches!(
+            predictor,
+            Predictor::Hydraulics | Predictor::Motor
+        ));
+        let mut step = vec![0.5; dims];
+        step.extend(std::iter::repeat_n(1.0, tolerance));
+        Candidate {
+            name,
+            predictor,
+            structure: Structure::None,
+            start: vec![0.0; dims + tolerance],
+            step,
+            grid,
+        }
     };
     let mut out = vec![
+        // The nominal model within its tolerances, per predictor (tolerance coordinate
+        // only; its grid runs over it).
+        one("none", Predictor::Hydraulics, log_grid(-2.0, 2.0, 5), 0),
+        one("none", Predictor::Motor, log_grid(-2.0, 2.0, 5), 0),
         // Search units: ln(coefficient / nominal leakage), from 1/20 to 20 times nominal.
         one(
             "extra_leakage",

@@ -76,8 +76,7 @@ impl Target<'_> {
 
     /// Normalised cost of `c` at `u`.
     pub fn cost(&self, c: &Candidate, u: &[f64]) -> f64 {
-        let mut rig = self.rig.clone();
-        c.effect(u, self.rig).apply(&mut rig);
+        let rig = c.rig_at(u, self.rig);
         let Ok(p) = predict(
             self.log,
             &rig,
@@ -133,7 +132,9 @@ pub fn fit(target: &Target<'_>, c: &Candidate) -> CandidateFit {
     let phase_grid = grid_is_phase(c);
     for g in &c.grid {
         let mut u = c.start.clone();
-        if phase_grid {
+        if c.name == "none" {
+            u[0] = *g;
+        } else if phase_grid {
             u[1] = *g;
         } else {
             u[0] = *g;
