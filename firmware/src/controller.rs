@@ -699,7 +699,7 @@ impl Controller {
             duration_s,
             reference,
             (lo, hi),
-            self.d.pwm_hz as f32,
+            self.cfg.rates.pwm_hz,
         )
         .map_err(CommandError::StepTest)?;
         self.set_step_reference(target, s.stepped);
