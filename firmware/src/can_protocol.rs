@@ -188,6 +188,19 @@ impl Frame {
     }
 }
 
+/// The frame in the `cansend`/`candump` notation of Linux SocketCAN: three hex digits of
+/// identifier, `#`, the payload in hex (`203#0A0000803E`), so a printed command can be
+/// sent with `cansend can0 <frame>`.
+impl core::fmt::Display for Frame {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{:03X}#", self.id)?;
+        for b in self.payload() {
+            write!(f, "{b:02X}")?;
+        }
+        Ok(())
+    }
+}
+
 /// Node number of a drive on the bus (0‥15).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct NodeId(u8);
@@ -584,6 +597,9 @@ impl Rejection {
         let (reason, bound) = match *err {
             ParamError::BelowMinimum { min, .. } => (RejectReason::BelowMinimum, min),
             ParamError::AboveMaximum { max, .. } => (RejectReason::AboveMaximum, max),
+            ParamError::NotWhileRunning { .. } => {
+                (RejectReason::NotAllowed, f32::from(Mode::Disabled.code()))
+            }
             ParamError::NotANumber { .. }
             | ParamError::NotWhole { .. }
             | ParamError::Inconsistent { .. } => (RejectReason::Invalid, 0.0),

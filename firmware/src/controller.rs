@@ -586,6 +586,9 @@ impl Controller {
         match c {
             Command::Heartbeat => Ok(()),
             Command::SetParameter { id, value } => {
+                if id.needs_disabled() && self.sup.mode() != Mode::Disabled {
+                    return Err(CommandError::Parameter(ParamError::NotWhileRunning { id }));
+                }
                 id.set(&mut self.cfg, value)
                     .map_err(CommandError::Parameter)?;
                 self.retune(id);

@@ -266,6 +266,12 @@ impl ParamId {
         self.spec().max
     }
 
+    /// True for a parameter that may change only while the bridge is off: a new encoder
+    /// offset turns the field orientation at once, a torque step no ramp can soften.
+    pub fn needs_disabled(self) -> bool {
+        self == ParamId::EncoderOffset
+    }
+
     /// True for a parameter that takes whole numbers only.
     pub fn is_integer(self) -> bool {
         self == ParamId::TelemetryDecimation
@@ -428,6 +434,11 @@ pub enum ParamError {
         /// The parameter.
         id: ParamId,
     },
+    /// Changeable only in Disabled ([`ParamId::needs_disabled`]).
+    NotWhileRunning {
+        /// The parameter.
+        id: ParamId,
+    },
     /// Within its bounds, but the configuration with it fails validation.
     Inconsistent {
         /// The parameter.
@@ -447,6 +458,7 @@ impl ParamError {
             | ParamError::AboveMaximum { id, .. }
             | ParamError::NotANumber { id }
             | ParamError::NotWhole { id }
+            | ParamError::NotWhileRunning { id }
             | ParamError::Inconsistent { id, .. } => id,
         }
     }
@@ -463,6 +475,7 @@ impl fmt::Display for ParamError {
             }
             ParamError::NotANumber { id } => write!(f, "{id}: not a number"),
             ParamError::NotWhole { id } => write!(f, "{id}: must be a whole number"),
+            ParamError::NotWhileRunning { id } => write!(f, "{id}: only in Disabled"),
             ParamError::Inconsistent { id, field, problem } => {
                 write!(f, "{id}: refused, config field `{field}` {problem}")
             }

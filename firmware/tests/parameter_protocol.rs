@@ -156,6 +156,16 @@ fn the_set_parameter_frame_is_the_documented_layout() {
     );
     assert_eq!(r.id(), 0x1A3);
     assert_eq!(r.payload(), &[10, 0x00, 0x00, 0x80, 0x3E, 0, 0, 0]);
+    // Printed for `cansend can0 …`.
+    assert_eq!(f_text(ParamId::SpeedKp, 0.25), "203#0A0000803E");
+    assert_eq!(
+        encode_command(&Request::SaveParameters, node()).to_string(),
+        "223#"
+    );
+}
+
+fn f_text(id: ParamId, value: f32) -> String {
+    encode_set_parameter(id, value, node()).to_string()
 }
 
 /// A RAM NOR flash for the save path (the power-cut tests are in `param_store`).
