@@ -12,6 +12,7 @@
 #![no_std]
 #![deny(missing_docs)]
 
+pub mod commissioning;
 pub mod config;
 pub mod scenario;
 
@@ -51,6 +52,7 @@ pub struct ClosedLoop {
     next_event: usize,
     heartbeat_every: u32,
     steps: u64,
+    external_torque_nm: f64,
 }
 
 /// Why a closed loop could not be built.
@@ -101,6 +103,7 @@ impl ClosedLoop {
             next_event: 0,
             heartbeat_every,
             steps: 0,
+            external_torque_nm: 0.0,
         })
     }
 
@@ -127,6 +130,12 @@ impl ClosedLoop {
     /// Sends a command as the bench PC would; refused commands are returned.
     pub fn command(&mut self, c: Command) -> Result<(), firmware::CommandError> {
         self.controller.command(c)
+    }
+
+    /// An external torque on the shaft from the next period on (a replay's tracking
+    /// correction; 0 by default, as on a real rig). [N·m]
+    pub fn set_external_torque_nm(&mut self, torque_nm: f64) {
+        self.external_torque_nm = torque_nm;
     }
 
     /// One PWM period: scenario commands due now, sample, control, integrate.
@@ -178,10 +187,9 @@ impl ClosedLoop {
         let out = self.controller.on_current_sample(&m);
         let recorded = record(&self.plant, &self.controller, out);
         let d = out.duties;
-        self.plant.advance(
-            self.period_s,
-            &Inputs::duties([d[0] as f64, d[1] as f64, d[2] as f64], out.pwm_enabled),
-        );
+        let mut inputs = Inputs::duties([d[0] as f64, d[1] as f64, d[2] as f64], out.pwm_enabled);
+        inputs.external_torque_nm = self.external_torque_nm;
+        self.plant.advance(self.period_s, &inputs);
         self.steps += 1;
         recorded
     }

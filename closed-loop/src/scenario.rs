@@ -18,6 +18,8 @@ pub enum ScenarioKind {
     SpeedStep,
     /// The payload moved slowly under speed control.
     SlowStroke,
+    /// The commissioning sequence (motor identification) on the free shaft.
+    Commissioning,
 }
 
 /// A named scenario.

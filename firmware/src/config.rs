@@ -7,6 +7,7 @@
 //! apart from controller state: [`crate::Controller::new`] derives its discrete-time
 //! constants from a validated `Config` and never mutates it.
 
+pub use crate::commissioning::CommissioningConfig;
 use core::fmt;
 
 /// Sample rates of the three loops.
@@ -203,6 +204,8 @@ pub struct Config {
     pub limits: FaultLimits,
     /// Calibration.
     pub calibration: CalibrationConfig,
+    /// Commissioning sequence (motor identification, issue 8).
+    pub commissioning: CommissioningConfig,
 }
 
 /// A configuration field that failed validation.
@@ -333,6 +336,7 @@ impl Config {
                 alignment_current_a: 5.0,
                 alignment_time_s: 0.5,
             },
+            commissioning: CommissioningConfig::nominal(),
         }
     }
 
@@ -551,7 +555,12 @@ impl Config {
         if k.alignment_time_s > 60.0 {
             return Err(err("calibration.alignment_time_s", "must be at most 60 s"));
         }
-        Ok(())
+        self.commissioning.validate(
+            l.over_current_a,
+            c.voltage_limit_v,
+            sp.speed_limit_rad_s,
+            r.pwm_hz,
+        )
     }
 }
 
@@ -575,7 +584,29 @@ mod tests {
     #[test]
     fn each_bad_field_is_named() {
         type Case = (fn(&mut Config), &'static str);
-        let cases: [Case; 14] = [
+        let cases: [Case; 19] = [
+            // 0.8 × the 45 A over-current trip is 36 A.
+            (
+                |c| c.commissioning.current_a = 40.0,
+                "commissioning.current_a",
+            ),
+            (
+                |c| c.commissioning.sweep_time_s = 0.01,
+                "commissioning.sweep_time_s",
+            ),
+            // 0.1 × 2π × 20 kHz = 12 566 rad/s.
+            (
+                |c| c.commissioning.current_bandwidth_rad_s = 13_000.0,
+                "commissioning.current_bandwidth_rad_s",
+            ),
+            (
+                |c| c.commissioning.spin_speed_rad_s = 250.0,
+                "commissioning.spin_speed_rad_s",
+            ),
+            (
+                |c| c.commissioning.plausible_ratio = f32::NAN,
+                "commissioning.plausible_ratio",
+            ),
             (|c| c.rates.pwm_hz = 0.0, "rates.pwm_hz"),
             (|c| c.rates.pwm_hz = 200e3, "rates.pwm_hz"),
             (|c| c.rates.speed_loop_hz = 3_000.0, "rates.speed_loop_hz"),

@@ -23,6 +23,7 @@
 //! the pressure loop starts bumplessly from the present speed reference. Entering Speed
 //! uses the last commanded speed setpoint (0 if none).
 
+use crate::commissioning::{Commissioning, CommissioningResult};
 use crate::config::{whole_ratio, Config};
 use crate::current_loop::{CurrentLoop, CurrentLoopState};
 use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
@@ -57,6 +58,10 @@ pub enum Command {
     ClearFaults,
     /// Keeps the command timeout from expiring.
     Heartbeat,
+    /// Enters Calibrating and runs the commissioning sequence after the current offsets
+    /// (motor identification and gain design, [`crate::commissioning`]) instead of the
+    /// plain encoder alignment.
+    Commission,
     /// Sets one parameter of the live table (bounds: [`ParamId::min`], [`ParamId::max`]).
     SetParameter {
         /// The parameter.
@@ -161,6 +166,7 @@ impl fmt::Display for CommandError {
 enum Calibration {
     Offsets { n: u32, sums: [u32; 3] },
     Align { n: u32 },
+    Commission,
 }
 
 /// Constants derived once from the configuration.
@@ -204,6 +210,13 @@ pub struct Controller {
     state: CurrentLoopState,
     command_status: u8,
     calibrated: bool,
+    commissioning: Commissioning,
+    commission_requested: bool,
+    /// Open-loop voltage commissioning asked for this period. [V]
+    open_loop_voltage: Option<Dq>,
+    commission_speed_on: bool,
+    /// The current loop runs at a forced angle this period (no speed decoupling).
+    forced_frame: bool,
     step: Option<ActiveStep>,
 }
 
@@ -262,6 +275,11 @@ impl Controller {
             state: CurrentLoopState::default(),
             command_status: 0,
             calibrated: false,
+            commissioning: Commissioning::new(config),
+            commission_requested: false,
+            open_loop_voltage: None,
+            commission_speed_on: false,
+            forced_frame: false,
             step: None,
         }
     }
@@ -321,6 +339,16 @@ impl Controller {
     /// Zero-current ADC results in use. [counts]
     pub fn current_offsets(&self) -> [f32; 3] {
         self.current.offsets()
+    }
+
+    /// The last completed commissioning's result (identified motor, derived gains).
+    pub fn commissioning_result(&self) -> Option<CommissioningResult> {
+        self.commissioning.result()
+    }
+
+    /// The commissioning sequence's state (progress, intermediate values).
+    pub fn commissioning(&self) -> &Commissioning {
+        &self.commissioning
     }
 
     /// Encoder electrical offset in use. [rad]
@@ -402,6 +430,7 @@ impl Controller {
                     };
                 }
                 Mode::Pressure => self.iq_ref = self.speed.step(self.speed_ref, w),
+                Mode::Calibrating => self.commission_speed_tick(w),
                 _ => {}
             }
         }
@@ -415,18 +444,27 @@ impl Controller {
                 let (on, theta, fault) = self.calibrate(m);
                 bridge = on;
                 theta_e = theta;
-                conditions.set(FaultCode::CurrentOffset, fault);
+                if let Some(f) = fault {
+                    conditions.set(f, true);
+                }
             }
             Mode::Disabled => {}
         }
 
-        let omega_e = self.speed.speed() * self.d.pole_pairs;
+        let omega_e = if self.forced_frame {
+            0.0
+        } else {
+            self.speed.speed() * self.d.pole_pairs
+        };
         self.state = if bridge {
             let i_ref = Dq {
                 d: self.id_ref,
                 q: self.iq_ref,
             };
-            self.current.step(m, theta_e, i_ref, omega_e)
+            match self.open_loop_voltage.take() {
+                Some(u) => self.current.apply_voltage(m, theta_e, u),
+                None => self.current.step(m, theta_e, i_ref, omega_e),
+            }
         } else {
             CurrentLoopState {
                 i_abc: self.current.phase_currents(m),
@@ -511,8 +549,8 @@ impl Controller {
         }
     }
 
-    /// One calibration sample: returns (bridge on, electrical angle to use, offset fault).
-    fn calibrate(&mut self, m: &Measurements) -> (bool, f32, bool) {
+    /// One calibration sample: returns (bridge on, electrical angle to use, fault found).
+    fn calibrate(&mut self, m: &Measurements) -> (bool, f32, Option<FaultCode>) {
         match self.calibration {
             Calibration::Offsets { n, sums } => {
                 let mut sums = sums;
@@ -527,15 +565,20 @@ impl Controller {
                         .iter()
                         .any(|o| (o - zero).abs() > self.cfg.calibration.offset_max_lsb);
                     if bad {
-                        return (false, 0.0, true);
+                        return (false, 0.0, Some(FaultCode::CurrentOffset));
                     }
                     self.current.set_offsets(offsets);
                     self.current.reset();
-                    self.calibration = Calibration::Align { n: 0 };
+                    self.calibration = if self.commission_requested {
+                        self.commissioning.start();
+                        Calibration::Commission
+                    } else {
+                        Calibration::Align { n: 0 }
+                    };
                 } else {
                     self.calibration = Calibration::Offsets { n, sums };
                 }
-                (false, 0.0, false)
+                (false, 0.0, None)
             }
             Calibration::Align { n } => {
                 self.id_ref = self.cfg.calibration.alignment_current_a;
@@ -554,11 +597,12 @@ impl Controller {
                     self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
                     // Disabled is always granted.
                     let _ = self.sup.request(Mode::Disabled);
-                    return (false, 0.0, false);
+                    return (false, 0.0, None);
                 }
                 self.calibration = Calibration::Align { n };
-                (true, 0.0, false)
+                (true, 0.0, None)
             }
+            Calibration::Commission => self.commission_step(m),
         }
     }
 
@@ -619,6 +663,11 @@ impl Controller {
                 self.speed_setpoint = rad_s;
                 Ok(())
             }
+            Command::Commission => {
+                self.apply(Command::SetMode(Mode::Calibrating))?;
+                self.commission_requested = true;
+                Ok(())
+            }
             Command::ClearFaults => {
                 self.sup.clear().map_err(CommandError::CausePresent)?;
                 self.encoder.rearm();
@@ -637,6 +686,7 @@ impl Controller {
                 if from != mode && mode == Mode::Calibrating {
                     self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
                 }
+                self.commission_requested = false;
                 Ok(())
             }
         }
@@ -775,5 +825,6 @@ impl Controller {
     }
 }
 
+mod commission;
 #[cfg(test)]
 mod tests;

@@ -17,7 +17,7 @@
 use crate::io::Measurements;
 use crate::pi::Pi;
 use crate::svpwm::modulate;
-use crate::transforms::{clarke, inverse_park, park, sin_cos, Dq};
+use crate::transforms::{clarke, inverse_park, park, sin_cos, Dq, SinCos};
 
 /// Everything the current-loop step measured and commanded.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -98,6 +98,21 @@ impl CurrentLoop {
         self.pi_q.reset(0.0);
     }
 
+    /// Replaces the PI gains (commissioning's design): `kp_d`, `kp_q` [V/A] and one `ki`
+    /// [V/(A·s)] for both axes (Ki = R_s·ω_c is the same on d and q), without an output step.
+    pub fn set_gains(&mut self, kp_d: f32, kp_q: f32, ki: f32) {
+        self.pi_d.set_gains(kp_d, ki);
+        self.pi_q.set_gains(kp_q, ki);
+    }
+
+    /// Replaces the machine constants of the decoupling feed-forward: L_d, L_q [H] and
+    /// ψ_f [Wb] (commissioning's identified values).
+    pub fn set_machine(&mut self, l_d: f32, l_q: f32, psi_f: f32) {
+        self.l_d = l_d;
+        self.l_q = l_q;
+        self.psi_f = psi_f;
+    }
+
     /// Phase currents from the ADC results. [A]
     #[inline]
     pub fn phase_currents(&self, m: &Measurements) -> [f32; 3] {
@@ -110,6 +125,30 @@ impl CurrentLoop {
         ]
     }
 
+    /// The sample's measurements at `theta_e` [rad] (phase and d-q currents, DC link),
+    /// before any control, with the angle's sin/cos.
+    #[inline]
+    fn measure(&self, m: &Measurements, theta_e: f32) -> (CurrentLoopState, SinCos) {
+        let i_abc = self.phase_currents(m);
+        let sc = sin_cos(theta_e);
+        let state = CurrentLoopState {
+            i_abc,
+            i_dq: park(clarke(i_abc[0], i_abc[1], i_abc[2]), sc),
+            u_dq: Dq::default(),
+            u_dc: m.adc_dc_link as f32 * self.v_per_lsb,
+            duties: [0.5; 3],
+        };
+        (state, sc)
+    }
+
+    /// Open-loop voltage: modulates `u_dq` [V] at `theta_e` [rad] without the PIs (their
+    /// integrators keep their state for the return to closed loop). Commissioning's
+    /// inductance pulses use it, where the voltage must be known exactly.
+    pub fn apply_voltage(&self, m: &Measurements, theta_e: f32, u_dq: Dq) -> CurrentLoopState {
+        let (state, sc) = self.measure(m, theta_e);
+        with_voltage(state, sc, u_dq)
+    }
+
     /// One current-loop step: measurement `m`, electrical angle `theta_e` [rad], current
     /// references `i_ref` [A] and electrical speed `omega_e` [rad/s] for the decoupling.
     #[inline]
@@ -120,10 +159,8 @@ impl CurrentLoop {
         i_ref: Dq,
         omega_e: f32,
     ) -> CurrentLoopState {
-        let i_abc = self.phase_currents(m);
-        let u_dc = m.adc_dc_link as f32 * self.v_per_lsb;
-        let sc = sin_cos(theta_e);
-        let i_dq = park(clarke(i_abc[0], i_abc[1], i_abc[2]), sc);
+        let (state, sc) = self.measure(m, theta_e);
+        let i_dq = state.i_dq;
         let (ff_d, ff_q) = if self.decoupling {
             (
                 -omega_e * self.l_q * i_dq.q,
@@ -136,15 +173,16 @@ impl CurrentLoop {
             d: self.pi_d.step(i_ref.d - i_dq.d, ff_d),
             q: self.pi_q.step(i_ref.q - i_dq.q, ff_q),
         };
-        let modulation = modulate(inverse_park(u_dq, sc), u_dc);
-        CurrentLoopState {
-            i_abc,
-            i_dq,
-            u_dq,
-            u_dc,
-            duties: modulation.duties,
-        }
+        with_voltage(state, sc, u_dq)
     }
+}
+
+/// `state` commanding `u_dq` [V] at the angle of `sc`: the voltage and its duties.
+#[inline]
+fn with_voltage(mut state: CurrentLoopState, sc: SinCos, u_dq: Dq) -> CurrentLoopState {
+    state.u_dq = u_dq;
+    state.duties = modulate(inverse_park(u_dq, sc), state.u_dc).duties;
+    state
 }
 
 #[cfg(test)]

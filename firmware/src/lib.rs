@@ -14,6 +14,7 @@
 
 pub mod can_protocol;
 pub mod can_server;
+pub mod commissioning;
 pub mod config;
 pub mod controller;
 pub mod current_loop;

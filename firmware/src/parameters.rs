@@ -557,6 +557,19 @@ pub fn cross_check(cfg: &Config) -> Result<(), ConfigError> {
             "must exceed speed.speed_limit_rad_s",
         );
     }
+    let k = &cfg.commissioning;
+    if k.pulse_voltage_v > 0.5 * cfg.current.voltage_limit_v {
+        return err(
+            "commissioning.pulse_voltage_v",
+            "must be > 0 and at most 0.5 * current.voltage_limit_v",
+        );
+    }
+    if k.spin_speed_rad_s > sp.speed_limit_rad_s {
+        return err(
+            "commissioning.spin_speed_rad_s",
+            "must be > 0 and at most speed.speed_limit_rad_s",
+        );
+    }
     Ok(())
 }
 

@@ -80,14 +80,22 @@ pub enum FaultCode {
     Watchdog = 11,
     /// Calibrated current offsets out of range. (12)
     CurrentOffset = 12,
+    /// Commissioning: a current step not reached (open phase, disconnected motor). (13)
+    CommissioningCurrent = 13,
+    /// Commissioning: an identified value not finite or outside the plausible window
+    /// around the nameplate. (14)
+    CommissioningImplausible = 14,
+    /// Commissioning: the encoder moved backwards (reversed), not at all, or the shaft did
+    /// not follow the current vector. (15)
+    CommissioningEncoder = 15,
     /// The stored parameter table was corrupt, of another version or inconsistent: the
-    /// defaults were loaded instead (codes 13–15 belong to commissioning). (16)
+    /// defaults were loaded instead. (16)
     ParameterStoreInvalid = 16,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 13] = [
+    pub const ALL: [FaultCode; 16] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -100,10 +108,13 @@ impl FaultCode {
         FaultCode::CommandTimeout,
         FaultCode::Watchdog,
         FaultCode::CurrentOffset,
+        FaultCode::CommissioningCurrent,
+        FaultCode::CommissioningImplausible,
+        FaultCode::CommissioningEncoder,
         FaultCode::ParameterStoreInvalid,
     ];
 
-    /// Telemetry code (1..=12, 16; 13–15 are left to the commissioning faults).
+    /// Telemetry code (1..=16).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -127,6 +138,9 @@ impl FaultCode {
                 | FaultCode::CommandTimeout
                 | FaultCode::Watchdog
                 | FaultCode::CurrentOffset
+                | FaultCode::CommissioningCurrent
+                | FaultCode::CommissioningImplausible
+                | FaultCode::CommissioningEncoder
                 | FaultCode::ParameterStoreInvalid
         )
     }
@@ -147,6 +161,11 @@ impl fmt::Display for FaultCode {
             FaultCode::CommandTimeout => "command timeout",
             FaultCode::Watchdog => "watchdog (control-loop overrun)",
             FaultCode::CurrentOffset => "current offset out of range",
+            FaultCode::CommissioningCurrent => "commissioning: current not reached (open phase?)",
+            FaultCode::CommissioningImplausible => "commissioning: implausible identified value",
+            FaultCode::CommissioningEncoder => {
+                "commissioning: encoder reversed or shaft not moving"
+            }
             FaultCode::ParameterStoreInvalid => "stored parameters invalid, defaults loaded",
         };
         write!(f, "fault {}: {}", self.code(), s)

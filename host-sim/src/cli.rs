@@ -85,6 +85,11 @@ pub struct SimulateArgs {
     /// Absorber precharge (gauge), replacing the rig's. [Pa]
     #[arg(long, value_name = "PA", value_parser = positive_f64)]
     pub precharge: Option<f64>,
+    /// Rig file of the simulated actuator when it is not the one the controller is
+    /// configured from (`--rig`, `--precharge`): a bench whose absorber or shaft differs
+    /// from what the engineer believes, as `eha tune` corrects.
+    #[arg(long, value_name = "FILE")]
+    pub plant_rig: Option<PathBuf>,
     /// Simulated duration, replacing the scenario's. [s]
     #[arg(long, value_name = "S", value_parser = positive_f64)]
     pub duration: Option<f64>,

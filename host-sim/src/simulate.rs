@@ -10,6 +10,7 @@ use crate::bench_log::{self, BenchLog};
 use crate::cli::{print_stdout, write_json, CliError, DemoArgs, SimulateArgs, SweepPrechargeArgs};
 use crate::plots::{line_chart, Marker, Series};
 use crate::pulsation::{amplitude_spectrum, dominant_line, peak_to_peak, sources, Source};
+use crate::rig_file;
 use crate::run::{run, Run, RunOptions};
 use closed_loop::{by_name, Scenario, SCENARIOS};
 use plant_model::effects::paper_low_speed_effects;
@@ -173,10 +174,14 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         .as_ref()
         .map(|e| e.0.clone())
         .unwrap_or_default();
-    let plant = plant_rig(&controller, &effects)?;
+    // The plant is the controller's rig unless the bench's actuator is given apart.
+    let plant = match &args.plant_rig {
+        Some(path) => plant_rig(&rig_file::load(path)?, &effects)?,
+        None => plant_rig(&controller, &effects)?,
+    };
     let duration = args.duration.unwrap_or(scenario.duration_s);
     let seed = args.seed.unwrap_or(1);
-    let metadata = vec![
+    let mut metadata = vec![
         ("source".into(), "simulation".into()),
         ("rig".into(), rig_name(rig).into()),
         ("scenario".into(), scenario.name.into()),
@@ -187,6 +192,9 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         ),
         ("seed".into(), format!("{seed}")),
     ];
+    if let Some(path) = &args.plant_rig {
+        metadata.push(("plant_rig".into(), path.display().to_string()));
+    }
     let r = run(
         &plant,
         &controller,

@@ -1,14 +1,586 @@
-//! `eha tune` (issue 8): identify a loop's plant from a setpoint step in a bench log and
-//! propose PI gains that meet a target.
+//! `eha tune` (issue 8): from a bench log holding a setpoint step of one loop, identify that
+//! loop's plant, propose gains meeting an overshoot/settling target, predict the step with
+//! them on the identified plant, and print the CAN commands that apply them.
+//!
+//! - [`step`]: finding the step, its overshoot and 2 % settling time;
+//! - [`speed`], [`pressure`]: each loop's identification (least squares on the integrated
+//!   plant equation) and design;
+//! - [`candidates`], [`predict`]: the closed-loop replays (the firmware's control core
+//!   against the plant model) the proposal is chosen and predicted with;
+//! - [`can`]: the `SetParameter` frames.
+//!
+//! The *current* gains are those of the controller configured from the rig (`--rig`, the
+//! rig the engineer believes in): for the pressure loop, its schedule's gains at the step's
+//! final setpoint.
 
-use crate::cli::{CliError, TuneArgs};
+pub mod can;
+pub mod candidates;
+pub mod fit;
+pub mod predict;
+pub mod pressure;
+pub mod speed;
+pub mod step;
+
+use crate::bench_log::BenchLog;
+use crate::cli::{is_stdout, print_stdout, write_json, CliError, LoopKind, TuneArgs};
+use can::Setting;
+use closed_loop::controller_config;
+use firmware::config::Config;
+use firmware::parameters::ParamId;
 use plant_model::Rig;
+use predict::StepSpec;
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use step::{Signal, Step, StepError, StepMetrics, Target};
+
+/// Default target of the speed loop: what its documented design (Table 1 gains, poles at
+/// −67 and −143 rad/s with the PI zero at −50 rad/s) achieves on the nominal rig with
+/// margin — 10.5 % overshoot and 0.02 s settling for the 0 → 50 rad/s step.
+pub const SPEED_TARGET: Target = Target {
+    overshoot_percent: 15.0,
+    settling_s: 0.1,
+};
+
+/// Default target of the pressure loop: what `firmware::pressure_loop` promises for steps
+/// within the speed limit (overshoot ≤ 15 %, 2 % settling ≤ 0.8 s, the setpoint ramp
+/// included).
+pub const PRESSURE_TARGET: Target = Target {
+    overshoot_percent: 15.0,
+    settling_s: 0.8,
+};
+
+/// Proportional and integral gain of a PI. Speed: [A/(rad/s)], [A/rad]; pressure:
+/// [(rad/s)/Pa], [(rad/s)/(Pa·s)].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gains {
+    /// Proportional gain.
+    pub kp: f64,
+    /// Integral gain.
+    pub ki: f64,
+}
+
+/// What was identified, per loop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Identified {
+    /// The shaft, and what the rig assumed.
+    Speed {
+        /// Identified.
+        shaft: speed::Shaft,
+        /// The rig's inertia. [kg·m²]
+        assumed_inertia_kg_m2: f64,
+        /// The rig's viscous friction. [N·m·s]
+        assumed_viscous_nm_s: f64,
+    },
+    /// The high-pressure side, and what the controller's schedule assumed.
+    Pressure {
+        /// Identified.
+        high: pressure::HighSide,
+        /// The schedule's precharge. [Pa]
+        assumed_precharge_pa: f64,
+        /// The schedule's oil capacitance `V_oil/β`. [m³/Pa]
+        assumed_oil_capacitance_m3_per_pa: f64,
+        /// Identified capacitance at the step's final setpoint. [m³/Pa]
+        capacitance_m3_per_pa: f64,
+        /// The schedule's capacitance there. [m³/Pa]
+        assumed_capacitance_m3_per_pa: f64,
+    },
+}
+
+/// The result of tuning one loop from one log.
+#[derive(Clone, Debug)]
+pub struct Tuning {
+    /// The loop.
+    pub loop_kind: LoopKind,
+    /// The step found in the log.
+    pub step: Step,
+    /// When the step's reference left its initial value in the log. [s]
+    pub step_time_s: f64,
+    /// Its replay (setpoints and windows) used for the predictions.
+    pub spec: StepSpec,
+    /// The target.
+    pub target: Target,
+    /// The identified plant.
+    pub identified: Identified,
+    /// The controller's configuration from the rig.
+    pub current_config: Config,
+    /// Its gains (the schedule's at the final setpoint for pressure).
+    pub current_gains: Gains,
+    /// The proposed configuration.
+    pub proposed_config: Config,
+    /// Its gains.
+    pub proposed_gains: Gains,
+    /// The parameters to send.
+    pub settings: Vec<Setting>,
+    /// The logged step's overshoot and settling.
+    pub measured: StepMetrics,
+    /// The proposal's, replayed on the identified plant.
+    pub predicted: StepMetrics,
+    /// The current gains replayed on the identified plant: how well the model reproduces
+    /// the log.
+    pub replayed_current: StepMetrics,
+    /// Remarks for the engineer.
+    pub notes: Vec<String>,
+}
+
+/// Why a log cannot be tuned from.
+#[derive(Debug, thiserror::Error)]
+pub enum TuneError {
+    /// The log lacks what the identification needs (exit 2).
+    #[error("{0}")]
+    BadLog(String),
+    /// A simulation or the identification's numerics failed.
+    #[error("{0}")]
+    Failed(String),
+}
+
+impl From<TuneError> for CliError {
+    fn from(e: TuneError) -> CliError {
+        match e {
+            TuneError::BadLog(m) => CliError::BadInput(m),
+            TuneError::Failed(m) => CliError::Failed(m),
+        }
+    }
+}
+
+/// The default target of a loop with the command line's overrides.
+pub fn target_for(kind: LoopKind, overshoot: Option<f64>, settling: Option<f64>) -> Target {
+    let d = match kind {
+        LoopKind::Speed => SPEED_TARGET,
+        LoopKind::Pressure => PRESSURE_TARGET,
+    };
+    Target {
+        overshoot_percent: overshoot.unwrap_or(d.overshoot_percent),
+        settling_s: settling.unwrap_or(d.settling_s),
+    }
+}
+
+/// Tunes `kind` from `log`, the controller configured from `rig`.
+pub fn tune(
+    rig: &Rig,
+    log: &BenchLog,
+    kind: LoopKind,
+    target: Target,
+) -> Result<Tuning, TuneError> {
+    let config = controller_config(rig);
+    config
+        .validate()
+        .map_err(|e| TuneError::BadLog(format!("the rig's controller configuration: {e:?}")))?;
+    let (signal, reference, response) = match kind {
+        LoopKind::Speed => {
+            let r = log.speed_ref_rad_s.as_deref().ok_or_else(|| {
+                TuneError::BadLog(
+                    "the log has no speed_ref_rad_s column: a speed step cannot be found".into(),
+                )
+            })?;
+            (Signal::Speed, r, &log.speed_rad_s[..])
+        }
+        LoopKind::Pressure => (Signal::Pressure, &log.p_ref_pa[..], &log.p_pa[..]),
+    };
+    let step = step::find(&log.t_s, reference, signal).map_err(|e| no_step(kind, e))?;
+    let limit = config.speed.speed_limit_rad_s as f64;
+    if signal == Signal::Speed && step.from.abs().max(step.to.abs()) >= 0.99 * limit {
+        // The pressure loop's output pinned at the limit holds too, but is no setpoint.
+        return Err(TuneError::BadLog(format!(
+            "no speed setpoint step in the log: its speed_ref_rad_s steps between {:.0} and \
+             {:.0} rad/s, at the {limit:.0} rad/s limit (a saturated pressure loop, not a \
+             speed setpoint)",
+            step.from, step.to
+        )));
+    }
+    let measured = step::metrics(&log.t_s, response, &step, signal);
+    let mut notes = Vec::new();
+    let job = Job {
+        rig,
+        config: &config,
+        log,
+        step,
+        target,
+    };
+    let t = match kind {
+        LoopKind::Speed => {
+            let rise = speed::rise_samples(log, &step);
+            if rise < speed::MIN_RISE_SAMPLES {
+                notes.push(format!(
+                    "the speed rose from 10 % to 90 % of the step in {rise} log samples: too few \
+                     to resolve the acceleration, so the identified inertia is uncertain (log \
+                     faster, or step smaller)"
+                ));
+            }
+            tune_speed(&job)?
+        }
+        LoopKind::Pressure => {
+            let at_limit = pressure::longest_at_speed_limit(log, &step, limit);
+            if at_limit > 0.25 * target.settling_s {
+                notes.push(format!(
+                    "the pump ran at the {limit:.0} rad/s speed limit for {at_limit:.2} s of the \
+                     step: its settling is limited by the pump's flow, which no gains change"
+                ));
+            }
+            tune_pressure(&job)?
+        }
+    };
+    let (spec, identified, proposal, replayed_current) = t;
+    if let Identified::Pressure { high, .. } = &identified {
+        if high.precharge_is_lower_bound {
+            notes.push(format!(
+                "the absorber took no oil in this log: its precharge is above {:.2} MPa, the \
+                 highest pressure reached; the proposal assumes it there (a step to higher \
+                 pressure would locate it)",
+                high.precharge_pa / 1e6
+            ));
+        }
+    }
+    if !proposal.metrics.meets(&target) {
+        notes.push(
+            "no candidate design meets the target on the identified plant: the proposal \
+             misses it least (the documented design where others gain under a tenth)"
+                .into(),
+        );
+    }
+    let cfg = &proposal.design.config;
+    let ids: &[ParamId] = match kind {
+        LoopKind::Speed => &[ParamId::SpeedKp, ParamId::SpeedKi],
+        LoopKind::Pressure => &[
+            ParamId::AbsorberPrechargePa,
+            ParamId::PressureBandwidth,
+            ParamId::PressureIntegralCornerRatio,
+        ],
+    };
+    let settings = ids
+        .iter()
+        .map(|&id| Setting {
+            id,
+            value: id.get(cfg) as f64,
+        })
+        .collect();
+    let current_gains = match kind {
+        LoopKind::Speed => Gains {
+            kp: config.speed.kp as f64,
+            ki: config.speed.ki as f64,
+        },
+        LoopKind::Pressure => pressure::gains_at(&config, step.to),
+    };
+    Ok(Tuning {
+        loop_kind: kind,
+        step,
+        step_time_s: log.t_s[step.start],
+        spec,
+        target,
+        identified,
+        current_config: config,
+        current_gains,
+        proposed_config: *cfg,
+        proposed_gains: proposal.design.gains,
+        settings,
+        measured,
+        predicted: proposal.metrics,
+        replayed_current,
+        notes,
+    })
+}
+
+/// What each loop's tuning starts from.
+#[derive(Clone, Copy)]
+struct Job<'a> {
+    rig: &'a Rig,
+    config: &'a Config,
+    log: &'a BenchLog,
+    step: Step,
+    target: Target,
+}
+
+/// What each loop's tuning produces: the replay, the identification, the chosen design, and
+/// the current gains replayed on the identified plant.
+type LoopTuning = (StepSpec, Identified, candidates::Candidate, StepMetrics);
+
+fn no_step(kind: LoopKind, e: StepError) -> TuneError {
+    let (what, column, min) = match kind {
+        LoopKind::Speed => ("speed", "speed_ref_rad_s", "5 rad/s"),
+        LoopKind::Pressure => ("pressure", "p_ref_pa", "0.2 MPa"),
+    };
+    let why = match e {
+        StepError::NoStep => format!("never changes by {min} or more"),
+        StepError::NoHold => "never holds a value for 20 ms (a loop output, not a setpoint)".into(),
+    };
+    TuneError::BadLog(format!(
+        "no {what} setpoint step in the log: its {column} {why}"
+    ))
+}
+
+fn tune_speed(job: &Job) -> Result<LoopTuning, TuneError> {
+    let (rig, config, log, step, target) = (job.rig, job.config, job.log, job.step, job.target);
+    let shaft = speed::identify(rig, log, &step).map_err(TuneError::BadLog)?;
+    let spec = replay_spec(Signal::Speed, log, &step, log.p_pa[0], &target);
+    let proposal =
+        speed::propose(rig, config, &shaft, &spec, &target).map_err(TuneError::Failed)?;
+    let identified = Identified::Speed {
+        shaft,
+        assumed_inertia_kg_m2: rig.shaft.inertia_kg_m2(),
+        assumed_viscous_nm_s: rig.shaft.viscous_nm_s,
+    };
+    let plant = speed::identified_rig(rig, &shaft);
+    finish(spec, identified, proposal, &plant, config)
+}
+
+fn tune_pressure(job: &Job) -> Result<LoopTuning, TuneError> {
+    let (rig, config, log, step, target) = (job.rig, job.config, job.log, job.step, job.target);
+    let high = pressure::identify(rig, log).map_err(TuneError::BadLog)?;
+    let p_start = log.p_pa[step.start.saturating_sub(1)];
+    let spec = replay_spec(Signal::Pressure, log, &step, p_start, &target);
+    let proposal =
+        pressure::propose(rig, config, &high, &spec, &target).map_err(TuneError::Failed)?;
+    let h = &config.hydraulics;
+    let identified = Identified::Pressure {
+        high,
+        assumed_precharge_pa: h.absorber_precharge_pa as f64,
+        assumed_oil_capacitance_m3_per_pa: (h.oil_volume_m3 / h.bulk_modulus_pa) as f64,
+        capacitance_m3_per_pa: pressure::capacitance_at(
+            &pressure::identified_hydraulics(h, &high),
+            step.to,
+        ),
+        assumed_capacitance_m3_per_pa: pressure::capacitance_at(h, step.to),
+    };
+    let plant = pressure::identified_rig(rig, &high);
+    finish(spec, identified, proposal, &plant, config)
+}
+
+/// The replay of the log's step: the scenarios' lead time at the initial setpoint (0.1 s
+/// speed, 0.5 s pressure), then as long after the step as the log shows, but at least twice
+/// the settling target and at most 0.5 s (speed) or 3 s (pressure).
+fn replay_spec(
+    signal: Signal,
+    log: &BenchLog,
+    step: &Step,
+    initial_pressure_pa: f64,
+    target: &Target,
+) -> StepSpec {
+    let (lead, min_after, max_after): (f64, f64, f64) = match signal {
+        Signal::Speed => (0.1, 2.0 * target.settling_s + 0.05, 0.5),
+        Signal::Pressure => (0.5, 2.0 * target.settling_s, 3.0),
+    };
+    predict::spec_of(
+        signal,
+        &log.t_s,
+        step,
+        initial_pressure_pa,
+        lead,
+        (min_after, max_after.max(min_after)),
+    )
+}
+
+/// Completes a loop's tuning with the current gains replayed on the identified `plant`.
+fn finish(
+    spec: StepSpec,
+    identified: Identified,
+    proposal: candidates::Candidate,
+    plant: &Rig,
+    config: &Config,
+) -> Result<LoopTuning, TuneError> {
+    let replayed = predict::simulate(plant, config, &spec, 1).map_err(TuneError::Failed)?;
+    Ok((spec, identified, proposal, replayed.metrics))
+}
+
+fn metrics_json(m: &StepMetrics, target: &Target) -> Value {
+    json!({
+        "overshoot_percent": m.overshoot_percent,
+        "settling_s": m.settling_s,
+        "meets_target": m.meets(target),
+    })
+}
+
+impl Tuning {
+    /// The `--json` document (`contracts/eha-cli.md`; `settling_s` is null for a response
+    /// that has not settled by the end of its window).
+    pub fn to_json(&self, commands: &[String]) -> Value {
+        let identified = match &self.identified {
+            Identified::Speed {
+                shaft,
+                assumed_inertia_kg_m2,
+                assumed_viscous_nm_s,
+            } => json!({
+                "inertia_kg_m2": shaft.inertia_kg_m2,
+                "viscous_nm_s": shaft.viscous_nm_s,
+                "load_nm": shaft.load_nm,
+                "fit_percent": shaft.fit_percent,
+                "assumed_inertia_kg_m2": assumed_inertia_kg_m2,
+                "assumed_viscous_nm_s": assumed_viscous_nm_s,
+            }),
+            Identified::Pressure {
+                high,
+                assumed_precharge_pa,
+                assumed_oil_capacitance_m3_per_pa,
+                capacitance_m3_per_pa,
+                assumed_capacitance_m3_per_pa,
+            } => json!({
+                "capacitance_m3_per_pa": capacitance_m3_per_pa,
+                "assumed_capacitance_m3_per_pa": assumed_capacitance_m3_per_pa,
+                "at_pressure_pa": self.step.to,
+                "oil_capacitance_m3_per_pa": high.oil_capacitance_m3_per_pa,
+                "assumed_oil_capacitance_m3_per_pa": assumed_oil_capacitance_m3_per_pa,
+                "precharge_pa": high.precharge_pa,
+                "precharge_is_lower_bound": high.precharge_is_lower_bound,
+                "assumed_precharge_pa": assumed_precharge_pa,
+                "leakage_m3_per_s_pa": high.leakage_m3_per_s_pa,
+                "max_pressure_pa": high.max_pressure_pa,
+                "fit_percent": high.fit_percent,
+            }),
+        };
+        let parameters: serde_json::Map<String, Value> = self
+            .settings
+            .iter()
+            .map(|s| (s.id.name().to_string(), json!(s.value)))
+            .collect();
+        json!({
+            "loop": loop_name(self.loop_kind),
+            "step": {"from": self.step.from, "to": self.step.to, "t_s": self.step_time_s},
+            "target": {
+                "overshoot_percent": self.target.overshoot_percent,
+                "settling_s": self.target.settling_s,
+            },
+            "identified": identified,
+            "current_gains": {"kp": self.current_gains.kp, "ki": self.current_gains.ki},
+            "proposed_gains": {"kp": self.proposed_gains.kp, "ki": self.proposed_gains.ki},
+            "proposed_parameters": parameters,
+            "measured": metrics_json(&self.measured, &self.target),
+            "predicted": metrics_json(&self.predicted, &self.target),
+            "current_replayed": metrics_json(&self.replayed_current, &self.target),
+            "can_commands": commands,
+            "notes": self.notes,
+        })
+    }
+
+    /// The report printed on standard output.
+    pub fn to_text(&self, commands: &[String]) -> String {
+        let mut s = String::new();
+        let (unit, scale) = match self.loop_kind {
+            LoopKind::Speed => ("rad/s", 1.0),
+            LoopKind::Pressure => ("MPa", 1e-6),
+        };
+        let _ = writeln!(
+            s,
+            "{} loop: step {:.2} → {:.2} {unit} at {:.3} s",
+            loop_name(self.loop_kind),
+            self.step.from * scale,
+            self.step.to * scale,
+            self.step_time_s
+        );
+        match &self.identified {
+            Identified::Speed {
+                shaft,
+                assumed_inertia_kg_m2,
+                ..
+            } => {
+                let _ = writeln!(
+                    s,
+                    "identified: inertia {:.3e} kg·m² ({:.2}× the rig's {:.3e}), viscous {:.2e} \
+                     N·m·s, load {:.3} N·m; fit {:.1} %",
+                    shaft.inertia_kg_m2,
+                    shaft.inertia_kg_m2 / assumed_inertia_kg_m2,
+                    assumed_inertia_kg_m2,
+                    shaft.viscous_nm_s,
+                    shaft.load_nm,
+                    shaft.fit_percent
+                );
+            }
+            Identified::Pressure {
+                high,
+                assumed_precharge_pa,
+                capacitance_m3_per_pa,
+                assumed_capacitance_m3_per_pa,
+                ..
+            } => {
+                let _ = writeln!(
+                    s,
+                    "identified: capacitance at {:.2} MPa {:.3e} m³/Pa (the schedule assumes \
+                     {:.3e}, {:.1}×); oil {:.3e} m³/Pa, leakage {:.2e} (m³/s)/Pa, absorber \
+                     precharge {}{:.2} MPa (assumed {:.2} MPa); fit {:.1} %",
+                    self.step.to * 1e-6,
+                    capacitance_m3_per_pa,
+                    assumed_capacitance_m3_per_pa,
+                    assumed_capacitance_m3_per_pa / capacitance_m3_per_pa,
+                    high.oil_capacitance_m3_per_pa,
+                    high.leakage_m3_per_s_pa,
+                    if high.precharge_is_lower_bound {
+                        "> "
+                    } else {
+                        ""
+                    },
+                    high.precharge_pa * 1e-6,
+                    assumed_precharge_pa * 1e-6,
+                    high.fit_percent
+                );
+            }
+        }
+        let settle = |m: &StepMetrics| {
+            m.settling_s
+                .map_or("not settled".to_string(), |v| format!("{v:.3} s"))
+        };
+        let _ = writeln!(
+            s,
+            "{:<44} {:>11} {:>11} {:>10} {:>12}",
+            "", "kp", "ki", "overshoot", "settling"
+        );
+        let rows = [
+            (
+                "current gains, measured in the log",
+                self.current_gains,
+                &self.measured,
+            ),
+            (
+                "current gains, replayed on identified plant",
+                self.current_gains,
+                &self.replayed_current,
+            ),
+            (
+                "proposed gains, predicted",
+                self.proposed_gains,
+                &self.predicted,
+            ),
+        ];
+        for (name, g, m) in rows {
+            let _ = writeln!(
+                s,
+                "{name:<44} {:>11.4e} {:>11.4e} {:>8.1} % {:>12}",
+                g.kp,
+                g.ki,
+                m.overshoot_percent,
+                settle(m)
+            );
+        }
+        let _ = writeln!(
+            s,
+            "{:<44} {:>11} {:>11} {:>8.1} % {:>10.3} s",
+            "target (at most)", "", "", self.target.overshoot_percent, self.target.settling_s
+        );
+        for n in &self.notes {
+            let _ = writeln!(s, "note: {n}");
+        }
+        let _ = writeln!(s, "CAN commands (cansend, node {}):", can::NODE);
+        for c in commands {
+            let _ = writeln!(s, "  {c}");
+        }
+        s
+    }
+}
+
+fn loop_name(kind: LoopKind) -> &'static str {
+    match kind {
+        LoopKind::Speed => "speed",
+        LoopKind::Pressure => "pressure",
+    }
+}
 
 /// `eha tune`.
-pub fn run_tune(_rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
-    crate::bench_log::read(&args.log)?;
-    Err(CliError::NotYetImplemented {
-        command: "tune",
-        issue: 8,
-    })
+pub fn run_tune(rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
+    let log = crate::bench_log::read(&args.log)?;
+    let target = target_for(args.loop_kind, args.overshoot, args.settling);
+    let t = tune(rig, &log, args.loop_kind, target)?;
+    let commands = can::command_lines(&t.settings).map_err(CliError::Failed)?;
+    if let Some(path) = &args.json {
+        write_json(path, &t.to_json(&commands))?;
+        if is_stdout(path) {
+            return Ok(());
+        }
+    }
+    print_stdout(&t.to_text(&commands))
 }

@@ -2,19 +2,15 @@
 //! error messages that name the problem, no partial output, the rig round trip and the
 //! accumulator-design numbers against hand computation.
 
+mod common;
+
+use common::{eha, s};
 use host_sim::rig_file;
 use plant_model::Rig;
 use std::f64::consts::PI;
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn eha(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eha"))
-        .args(args)
-        .output()
-        .expect("the eha binary runs")
-}
+use std::process::Output;
 
 fn status(o: &Output) -> i32 {
     o.status.code().expect("exited, not killed by a signal")
@@ -30,14 +26,7 @@ fn stdout(o: &Output) -> String {
 
 /// A fresh, empty folder per test.
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}"));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::scratch("cli", name)
 }
 
 // ---------------------------------------------------------------- bench logs

@@ -2,24 +2,16 @@
 //! bench log that reads back with the frames' values; a malformed telemetry line exits 2
 //! naming file and line, and no output file appears.
 
+mod common;
+
+use common::eha;
 use firmware::{Mode, TelemetryFrame};
 use host_sim::bench_log;
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn eha(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_eha"))
-        .args(args)
-        .output()
-        .expect("the eha binary runs")
-}
+use std::path::PathBuf;
 
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ingest-{name}"));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch("ingest", name)
 }
 
 /// A frame whose values are exact in f32 and differ per sample.

@@ -32,6 +32,7 @@ fn main() {
             drive: Drive::ShaftSpeed { omega_rad_s: omega },
             piston: None,
             external_force_n: 0.0,
+            external_torque_nm: 0.0,
         };
         plant.advance(1.0, &inputs);
         let (mut lo, mut hi, mut sum, n) = (f64::MAX, f64::MIN, 0.0, 20_000);

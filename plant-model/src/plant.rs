@@ -128,6 +128,9 @@ pub struct Inputs {
     /// External load force on the piston, positive towards +x (F_L of eq. 12 with the
     /// opposite sign). [N]
     pub external_force_n: f64,
+    /// External torque on the shaft, positive in the direction of rotation (a replay's
+    /// tracking correction; 0 on a real rig). [N·m]
+    pub external_torque_nm: f64,
 }
 
 impl Inputs {
@@ -137,6 +140,7 @@ impl Inputs {
             drive: Drive::Inverter { duties, enabled },
             piston: None,
             external_force_n: 0.0,
+            external_torque_nm: 0.0,
         }
     }
 }
@@ -951,7 +955,8 @@ impl Plant {
         let (p_a, p_b) = (x[ix::PA], x[ix::PB]);
         let factor = at.factor;
         let t_pump = self.pump.load_torque(p_a, p_b, factor);
-        aux.shaft_drive = t_em + t_cog - t_pump - self.shaft_viscous * omega;
+        aux.shaft_drive =
+            t_em + t_cog - t_pump - self.shaft_viscous * omega + inputs.external_torque_nm;
         let t_fric = self.shaft_friction.force(self.discrete.shaft);
         dx[ix::THETA] = omega;
         match inputs.drive {
@@ -1040,7 +1045,7 @@ impl Plant {
             // Prescribed motion: the piston's force balance is supplied from outside.
             p_in += -aux.piston_drive * vp;
         }
-        dx[ix::E_EXT] = -inputs.external_force_n * vp;
+        dx[ix::E_EXT] = -inputs.external_force_n * vp - inputs.external_torque_nm * x[ix::OMEGA];
         dx[ix::E_MECH] = p_mech;
         dx[ix::E_HYD] = p_hyd;
 
@@ -1090,5 +1095,6 @@ fn sanitise(inputs: &Inputs) -> Inputs {
             .piston
             .map(|(x, v)| (finite_or(x, 0.0), finite_or(v, 0.0))),
         external_force_n: finite_or(inputs.external_force_n, 0.0),
+        external_torque_nm: finite_or(inputs.external_torque_nm, 0.0),
     }
 }

@@ -152,6 +152,7 @@ fn torque_is_eq_3_and_accelerates_the_shaft() {
             drive: Drive::Currents { i_d, i_q },
             piston: None,
             external_force_n: 0.0,
+            external_torque_nm: 0.0,
         };
         plant.advance(1e-5, &inputs);
         let o = plant.observe();
@@ -190,6 +191,7 @@ fn cogging_appears_at_lcm_of_slots_and_poles() {
         drive: Drive::ShaftSpeed { omega_rad_s: omega },
         piston: None,
         external_force_n: 0.0,
+        external_torque_nm: 0.0,
     };
     let samples: Vec<f64> = (0..n)
         .map(|_| {
@@ -321,6 +323,7 @@ fn speed_drive(omega: f64) -> Inputs {
         drive: Drive::ShaftSpeed { omega_rad_s: omega },
         piston: None,
         external_force_n: 0.0,
+        external_torque_nm: 0.0,
     }
 }
 
@@ -577,6 +580,7 @@ fn step_never_panics_on_bad_inputs() {
             },
             piston: None,
             external_force_n: f64::NAN,
+            external_torque_nm: 0.0,
         },
         Inputs {
             drive: Drive::ShaftSpeed {
@@ -584,6 +588,7 @@ fn step_never_panics_on_bad_inputs() {
             },
             piston: Some((f64::NAN, 1e9)),
             external_force_n: 0.0,
+            external_torque_nm: 0.0,
         },
     ] {
         for dt in [-1.0, 0.0, f64::NAN, 1e-4] {

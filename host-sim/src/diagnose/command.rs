@@ -1,13 +1,61 @@
-//! `eha diagnose` (issue 5): the command around the diagnosis.
+//! `eha diagnose LOG.csv [--json PATH] [--report DIR]`: reads the log, diagnoses it against
+//! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
-use crate::cli::{CliError, DiagnoseArgs};
+use super::analysis::analyse;
+use crate::cli::{print_stdout, write_json, CliError, DiagnoseArgs};
 use plant_model::Rig;
 
 /// `eha diagnose`.
-pub fn run_diagnose(_rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
-    crate::bench_log::read(&args.log)?;
-    Err(CliError::NotYetImplemented {
-        command: "diagnose",
-        issue: 5,
-    })
+pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
+    let log = crate::bench_log::read(&args.log)?;
+    let analysis = analyse(&log, rig).map_err(|e| CliError::Failed(e.to_string()))?;
+    let d = &analysis.diagnosis;
+    let mut text = String::new();
+    text.push_str(&format!(
+        "{}: {} samples; identification {:.3}–{:.3} s, validation {:.3}–{:.3} s\n",
+        args.log.display(),
+        d.samples,
+        d.identification_segment_s[0],
+        d.identification_segment_s[1],
+        d.validation_segment_s[0],
+        d.validation_segment_s[1]
+    ));
+    text.push_str("rank  effect                  score  parameters\n");
+    for (k, c) in d.causes.iter().enumerate() {
+        let params: Vec<String> = c
+            .parameters
+            .iter()
+            .map(|(n, v)| format!("{n}={v:.4e}"))
+            .collect();
+        text.push_str(&format!(
+            "{:>4}  {:<22} {:>6.3}  {}\n",
+            k + 1,
+            c.effect,
+            c.score,
+            params.join(" ")
+        ));
+    }
+    text.push_str(&format!(
+        "cause: {} — {}\n",
+        d.causes[0].effect, d.causes[0].evidence
+    ));
+    text.push_str("validation fit [%]   baseline  extended\n");
+    for (signal, b) in &d.baseline.fit_percent_by_signal {
+        let e = d.extended.fit_percent_by_signal.get(signal).copied();
+        text.push_str(&format!(
+            "  {:<18} {:>8.1}  {:>8.1}\n",
+            signal,
+            b,
+            e.unwrap_or(f64::NAN)
+        ));
+    }
+    print_stdout(&text)?;
+    if let Some(dir) = &args.report {
+        super::report::write_report(dir, &args.log, &analysis)?;
+    }
+    if let Some(path) = &args.json {
+        let value = serde_json::to_value(d).map_err(|e| CliError::Failed(e.to_string()))?;
+        write_json(path, &value)?;
+    }
+    Ok(())
 }

@@ -1,5 +1,5 @@
-//! Groundwork of `eha diagnose` (issue 5): replaying a bench log in the simulation, one
-//! subsystem at a time, and scoring how well the simulation explains it.
+//! `eha diagnose` (issue 5): what the simulation gets wrong on a bench log, why, the
+//! extended model, and the gain on data the fit never saw.
 //!
 //! - [`replay`]: the subsystem replays — hydraulics driven by the logged shaft angle (or
 //!   speed) and piston position, motor and shaft driven by the logged d-q currents — with
@@ -7,18 +7,30 @@
 //! - [`fit_percent`] and [`residual`]: the contract's goodness of fit (normalised root mean
 //!   square error, MATLAB `compare`) and the residual the diagnosis analyses.
 //!
-//! The CLI command stays routed to its placeholder until the analysis is built on this.
+//! - [`predict`], [`electrical`], [`closed_replay`]: the predictors the diagnosis compares
+//!   with the log (hydraulics, motor, stator voltages; the whole closed loop).
+//! - [`spectrum`]: residual order spectra against the shaft angle.
+//! - [`candidates`], [`fit`]: the catalogue's effects as candidates, fitted with `argmin`.
+//! - [`analysis`]: the diagnosis itself; [`diagnosis`]: its result (the contract's JSON);
+//!   [`report`]: the markdown report; [`command`]: `eha diagnose`.
 
+pub mod analysis;
+pub mod candidates;
+pub mod closed_replay;
 pub mod command;
 pub mod diagnosis;
+pub mod electrical;
+pub mod fit;
+pub mod predict;
 pub mod replay;
+pub mod report;
+pub mod spectrum;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 
-pub use replay::{replay_hydraulics, replay_motor, Replay, ReplayError, ReplayKind};
-
-use crate::bench_log::BenchLog;
-use plant_model::Rig;
+pub use replay::{
+    replay_hydraulics, replay_motor, replay_with, Replay, ReplayError, ReplayKind, ReplayOptions,
+};
 
 /// Why a log could not be diagnosed.
 #[derive(Debug, thiserror::Error)]
@@ -31,14 +43,7 @@ pub enum DiagnoseError {
     Unusable(String),
 }
 
-/// Diagnoses `log` against the nominal model `rig`: replays, residual analysis, candidate
-/// ranking, fit on the identification segment, score on the validation segment.
-pub fn diagnose(log: &BenchLog, rig: &Rig) -> Result<Diagnosis, DiagnoseError> {
-    let _ = (log, rig);
-    Err(DiagnoseError::Unusable(
-        "diagnosis not built yet (issue 5)".into(),
-    ))
-}
+pub use analysis::{analyse, diagnose, Analysis};
 
 /// Goodness of fit in percent, 100·(1 − ‖y − ŷ‖₂ / ‖y − mean(y)‖₂), of `simulated` (ŷ)
 /// against `measured` (y): 100 is a perfect match, 0 is no better than the measured mean,

@@ -41,6 +41,7 @@
 //! at the logged angle and the first interval's mean speed (or the logged speed).
 
 use crate::bench_log::{BenchLog, BenchLogError};
+use firmware::speed_observer::SpeedObserver;
 use plant_model::{Drive, InitialConditions, Inputs, Plant, Rig, RigError};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -94,10 +95,15 @@ pub struct Replay {
     pub p_pa: Vec<f64>,
     /// Port-B pressure. [Pa]
     pub p_low_pa: Vec<f64>,
-    /// Shaft speed. [rad/s]
+    /// Shaft speed: in a motor replay as the firmware's encoder observer estimates it (what
+    /// the log's `speed_rad_s` is), else the true speed. [rad/s]
     pub speed_rad_s: Vec<f64>,
     /// Shaft angle, unwrapped. [rad]
     pub theta_m_rad: Vec<f64>,
+    /// Motor replay: the q current the model needed to follow the logged shaft motion, the
+    /// logged current plus the tracking correction (see [`TRACKING_BANDWIDTH_RAD_S`]); the
+    /// logged current in a hydraulic replay. Compare with the log's `iq_a`. [A]
+    pub iq_needed_a: Vec<f64>,
 }
 
 impl Replay {
@@ -112,23 +118,68 @@ impl Replay {
     }
 }
 
+/// How a replay departs from the defaults.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReplayOptions {
+    /// Replay only the first `rows` rows (the identification segment). `usize::MAX`: all.
+    pub rows: usize,
+    /// Simulate the piston under the rig's load (friction, viscous damping, gravity, end
+    /// stops) from the logged start instead of prescribing it from `x_m`: then cylinder
+    /// friction shows in the port pressures. Ignored when `x_m` is not logged.
+    pub piston_free: bool,
+    /// A DC offset of phase a's current channel, assumed in the log's `id_a`/`iq_a` (motor
+    /// replay): the motor is driven with the currents that flowed, the logged ones less the
+    /// offset's d-q image at the logged angle. [A]
+    pub phase_a_offset_a: f64,
+}
+
+impl Default for ReplayOptions {
+    fn default() -> Self {
+        ReplayOptions {
+            rows: usize::MAX,
+            piston_free: false,
+            phase_a_offset_a: 0.0,
+        }
+    }
+}
+
 /// Replays the hydraulics of `log` on `rig`: the shaft prescribed from the logged angle
 /// (or speed), the piston from `x_m` (or blocked). See the module documentation.
 pub fn replay_hydraulics(log: &BenchLog, rig: &Rig) -> Result<Replay, ReplayError> {
-    replay(log, rig, ReplayKind::Hydraulics)
+    replay_with(log, rig, ReplayKind::Hydraulics, &ReplayOptions::default())
 }
 
 /// Replays motor and shaft of `log` on `rig`: the d-q currents prescribed from `id_a` and
 /// `iq_a`, the hydraulics following the simulated shaft, the piston from `x_m` (or
 /// blocked). See the module documentation.
 pub fn replay_motor(log: &BenchLog, rig: &Rig) -> Result<Replay, ReplayError> {
-    replay(log, rig, ReplayKind::Motor)
+    replay_with(log, rig, ReplayKind::Motor, &ReplayOptions::default())
 }
+
+/// Bandwidth of the motor replay's tracking of the logged shaft angle. [rad/s]
+///
+/// Prescribed currents alone leave the shaft on a very soft spring: in pressure holding the
+/// pump's stiffness D²/(4π²·C) against the inertia gives ≈ 1.3 rad/s, barely damped, so the
+/// current sensor's noise and any small torque error make the simulated speed wander by
+/// more than the effects sought. A critically damped PD torque pulls the simulated shaft
+/// to the logged angle below this bandwidth; above it (cogging, flux harmonics, a current
+/// offset's first electrical harmonic at any useful speed) the model's own dynamics show in
+/// the speed, and below it a missing torque shows as the current the model needed.
+pub const TRACKING_BANDWIDTH_RAD_S: f64 = 6.0;
+
+/// Sub-counts per encoder count of the motor replay's speed observer.
+const OBSERVER_SUBCOUNTS: u32 = 1024;
 
 /// The name errors give an in-memory log (the CLI has named the file when reading it).
 const IN_MEMORY: &str = "bench log being replayed";
 
-fn replay(log: &BenchLog, rig: &Rig, kind: ReplayKind) -> Result<Replay, ReplayError> {
+/// Replays `log` on `rig` as `kind` with `options`.
+pub fn replay_with(
+    log: &BenchLog,
+    rig: &Rig,
+    kind: ReplayKind,
+    options: &ReplayOptions,
+) -> Result<Replay, ReplayError> {
     log.check(Path::new(IN_MEMORY))?;
     let theta = log.theta_m_rad.as_deref().map(unwrap_angle);
     // Shooting for the initial pressure: replay the first rows' hydraulics from the first
@@ -138,13 +189,17 @@ fn replay(log: &BenchLog, rig: &Rig, kind: ReplayKind) -> Result<Replay, ReplayE
     // starts from the same estimate (its shaft would answer a wrong start within the head,
     // so shooting through it would fit the start to the current noise instead).
     let head = INITIAL_SAMPLES.min(log.len());
+    let head_options = ReplayOptions {
+        rows: head,
+        ..*options
+    };
     let trial = simulate(
         log,
         rig,
         ReplayKind::Hydraulics,
         theta.as_deref(),
         log.p_pa[0],
-        head,
+        &head_options,
     )?;
     let offset = log.p_pa[..head]
         .iter()
@@ -158,24 +213,29 @@ fn replay(log: &BenchLog, rig: &Rig, kind: ReplayKind) -> Result<Replay, ReplayE
         kind,
         theta.as_deref(),
         log.p_pa[0] + offset,
-        log.len(),
+        options,
     )
 }
 
-/// Replays the first `rows` rows of a checked `log` from port pressure `p0_pa`.
+/// Replays the first `options.rows` rows of a checked `log` from port pressure `p0_pa`.
 fn simulate(
     log: &BenchLog,
     rig: &Rig,
     kind: ReplayKind,
     theta: Option<&[f64]>,
     p0_pa: f64,
-    rows: usize,
+    options: &ReplayOptions,
 ) -> Result<Replay, ReplayError> {
-    let n = rows.min(log.len());
+    let n = options.rows.min(log.len()).max(2);
     let t = &log.t_s[..n];
-    let x_piston = log.x_m.as_deref();
+    let x_logged = log.x_m.as_deref();
+    let x_piston = x_logged.filter(|_| !options.piston_free);
+    // The offset's d-q image rotates with the electrical angle: at the logged angle when
+    // there is one, else at the simulated shaft's.
+    let pole_pairs = rig.motor.pole_pairs as f64;
+    let offset_a = options.phase_a_offset_a;
     let mut rig = rig.clone();
-    if x_piston.is_none() {
+    if x_logged.is_none() {
         rig.cylinder.blocked = true;
     }
     // The log was checked (at least MIN_ROWS rows) and `rows` ≥ 2, so the first interval
@@ -184,7 +244,7 @@ fn simulate(
     let init = InitialConditions {
         p_a_pa: p0_pa,
         p_b_pa: log.p_low_pa.as_ref().map_or(rig.fill.pressure_pa, |p| p[0]),
-        x_m: x_piston.map_or(0.0, |x| x[0]),
+        x_m: x_logged.map_or(0.0, |x| x[0]),
         omega_rad_s: theta.map_or(log.speed_rad_s[0], |th| (th[1] - th[0]) / dt0),
         theta_m_rad: theta.map_or(0.0, |th| th[0]),
     };
@@ -202,15 +262,49 @@ fn simulate(
         p_low_pa: Vec::with_capacity(n),
         speed_rad_s: Vec::with_capacity(n),
         theta_m_rad: Vec::with_capacity(n),
+        iq_needed_a: Vec::with_capacity(n),
     };
-    let mut record = |plant: &Plant| {
+    let record = |out: &mut Replay, plant: &Plant, iq_a: f64, speed: Option<f64>| {
         let o = plant.observe();
         out.p_pa.push(o.p_sensor_pa);
         out.p_low_pa.push(o.p_b_pa);
-        out.speed_rad_s.push(o.omega_m_rad_s);
+        out.speed_rad_s.push(speed.unwrap_or(o.omega_m_rad_s));
         out.theta_m_rad.push(o.theta_m_rad);
+        out.iq_needed_a.push(iq_a);
     };
-    record(&plant);
+    // The motor replay's reference angle: the logged one, or the logged speed integrated.
+    let theta_ref: Vec<f64> = match theta {
+        Some(th) => th[..n].to_vec(),
+        None => {
+            let mut acc = 0.0;
+            let mut v = vec![0.0];
+            for k in 1..n {
+                acc += 0.5 * (log.speed_rad_s[k] + log.speed_rad_s[k - 1]) * (t[k] - t[k - 1]);
+                v.push(acc);
+            }
+            v
+        }
+    };
+    let j_total = rig.shaft.inertia_kg_m2();
+    let k_t = rig.motor.torque_constant_nm_per_a();
+    let w_o = TRACKING_BANDWIDTH_RAD_S;
+    let mut correction_a = 0.0;
+    // The logged speed is the firmware's encoder observer's estimate (its PLL filters the
+    // fast ripple the diagnosis looks at), so the motor replay's speed goes through the
+    // same observer, fed with the simulated shaft angle on a 1024 times finer grid: its
+    // dynamics without the encoder's quantisation noise, which the prediction should not
+    // add a second, independent time to the log's own.
+    let cpr = rig
+        .sensors
+        .encoder
+        .counts_per_rev
+        .saturating_mul(OBSERVER_SUBCOUNTS);
+    let counts_per_rad = cpr as f64 / (2.0 * PI);
+    let observer_bandwidth = closed_loop::controller_config(&rig)
+        .speed
+        .observer_bandwidth_rad_s;
+    let mut observer: Option<SpeedObserver> = None;
+    record(&mut out, &plant, log.iq_a[0], None);
     let lerp = |y: &[f64], k: usize, f: f64| y[k] + (y[k + 1] - y[k]) * f;
     for k in 0..n.saturating_sub(1) {
         let dt = t[k + 1] - t[k];
@@ -225,10 +319,33 @@ fn simulate(
                 ReplayKind::Hydraulics => Drive::ShaftSpeed {
                     omega_rad_s: mean_speed.unwrap_or_else(|| lerp(&log.speed_rad_s, k, mid)),
                 },
-                ReplayKind::Motor => Drive::Currents {
-                    i_d: lerp(&log.id_a, k, mid),
-                    i_q: lerp(&log.iq_a, k, mid),
-                },
+                ReplayKind::Motor => {
+                    let (mut i_d, mut i_q) = (lerp(&log.id_a, k, mid), lerp(&log.iq_a, k, mid));
+                    let o = plant.observe();
+                    let position = (o.theta_m_rad * counts_per_rad).floor() as i64;
+                    let obs = observer.get_or_insert_with(|| {
+                        let mut s = SpeedObserver::new(observer_bandwidth, (1.0 / h) as f32, cpr);
+                        s.reset(position);
+                        s
+                    });
+                    obs.update(position);
+                    let w_ref = (theta_ref[k + 1] - theta_ref[k]) / dt;
+                    let torque = j_total
+                        * (w_o * w_o * (lerp(&theta_ref, k, start) - o.theta_m_rad)
+                            + 2.0 * w_o * (w_ref - o.omega_m_rad_s));
+                    correction_a = torque / k_t;
+                    i_q += correction_a;
+                    if offset_a != 0.0 {
+                        // Amplitude-invariant Clarke of (offset, 0, 0) is (offset, offset/√3);
+                        // the controller measured true + offset, so the truth is less it.
+                        let th = pole_pairs * o.theta_m_rad;
+                        let (s, c) = (th.sin(), th.cos());
+                        let (a, b) = (offset_a, offset_a / 3f64.sqrt());
+                        i_d -= a * c + b * s;
+                        i_q -= -a * s + b * c;
+                    }
+                    Drive::Currents { i_d, i_q }
+                }
             };
             let piston = x_piston
                 .zip(piston_speed)
@@ -239,10 +356,12 @@ fn simulate(
                     drive,
                     piston,
                     external_force_n: 0.0,
+                    external_torque_nm: 0.0,
                 },
             );
         }
-        record(&plant);
+        let observed = observer.as_ref().map(|o| o.speed_rad_s() as f64);
+        record(&mut out, &plant, log.iq_a[k + 1] + correction_a, observed);
     }
     Ok(out)
 }
@@ -250,7 +369,7 @@ fn simulate(
 /// Unwraps an angle logged wrapped (to [0, 2π) or any 2π range) or already unwrapped: each
 /// step is taken as the one of its 2π-equivalents closest to zero, which is right while
 /// the shaft turns less than half a revolution per log interval (3 000 rad/s at 1 kHz).
-fn unwrap_angle(wrapped: &[f64]) -> Vec<f64> {
+pub fn unwrap_angle(wrapped: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(wrapped.len());
     let mut acc = wrapped.first().copied().unwrap_or(0.0);
     let mut prev = acc;

@@ -1,0 +1,434 @@
+//! The diagnosis: what the nominal model gets wrong on a log, which effect of the catalogue
+//! explains it, with which parameters, and what that gains on data the fit never saw.
+//!
+//! 1. Segments: identification = the first half of the log (at most
+//!    [`MAX_IDENTIFICATION_S`]), validation = the rest.
+//! 2. Baseline: every subsystem replay ([`super::predict`]) and the closed loop
+//!    ([`super::closed_replay`]) on the nominal rig over the whole log; residuals.
+//! 3. Evidence: the residuals' order spectra against the shaft angle
+//!    ([`super::spectrum`]) point at angle-locked effects and fix the cogging order.
+//! 4. Every candidate ([`super::candidates`]) is fitted on the identification rows
+//!    ([`super::fit`], in parallel): its score is the fraction of the nominal model's error
+//!    on its signals it removes there.
+//! 5. The best candidate that is a fault (beyond the rig's tolerances, see
+//!    [`Candidate::is_significant`]) is kept only if it also improves its signals on the
+//!    validation segment; otherwise the answer is `none`.
+
+use super::candidates::{candidates, Candidate};
+use super::closed_replay::replay_closed_loop;
+use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
+use super::fit::{fit, CandidateFit, Target};
+use super::predict::{piston_moves, predict, Predicted, Predictor};
+use super::replay::{unwrap_angle, ReplayError, INITIAL_SAMPLES};
+use super::spectrum::{order_spectrum, OrderSpectrum};
+use super::{fit_percent, DiagnoseError};
+use crate::bench_log::{BenchLog, Signal};
+use plant_model::Rig;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Longest identification segment: the fit replays it once per evaluation, so this bounds
+/// the diagnosis's time on long logs (a few seconds hold every effect's signature). [s]
+pub const MAX_IDENTIFICATION_S: f64 = 4.0;
+
+/// Fraction of the nominal model's identification error a candidate must remove to be
+/// considered at all. [1]
+pub const MIN_EXPLAINED: f64 = 0.2;
+
+/// Validation-fit improvement, on the candidate's own signals, below which an extension is
+/// not kept. [percentage points]
+pub const MIN_VALIDATION_GAIN_POINTS: f64 = 1.0;
+
+/// Everything the diagnosis computed, for the JSON and the report.
+pub struct Analysis {
+    /// The contract's result.
+    pub diagnosis: Diagnosis,
+    /// The log's time. [s]
+    pub t_s: Vec<f64>,
+    /// Measured signals by name.
+    pub measured: BTreeMap<&'static str, Vec<f64>>,
+    /// Baseline predictions by signal name, whole log.
+    pub baseline: BTreeMap<&'static str, Vec<f64>>,
+    /// Extended predictions by signal name, whole log (equal to the baseline when nothing
+    /// was kept).
+    pub extended: BTreeMap<&'static str, Vec<f64>>,
+    /// Order spectra of the baseline residuals (pressure, speed), when the shaft turned.
+    pub spectra: Vec<(&'static str, OrderSpectrum)>,
+    /// Orders the candidates point at, for the plots: (order, effect).
+    pub candidate_orders: Vec<(u32, &'static str)>,
+    /// Every candidate's fit.
+    pub fits: Vec<CandidateFit>,
+}
+
+/// Diagnoses `log` against the nominal model `rig`.
+pub fn diagnose(log: &BenchLog, rig: &Rig) -> Result<Diagnosis, DiagnoseError> {
+    analyse(log, rig).map(|a| a.diagnosis)
+}
+
+fn column<'a>(log: &'a BenchLog, name: &str) -> Option<&'a [f64]> {
+    log.column(Signal::from_name(name)?)
+}
+
+/// The predictors the log supports.
+fn predictors(log: &BenchLog) -> Vec<Predictor> {
+    let mut p = vec![Predictor::Hydraulics, Predictor::Motor];
+    if log.theta_m_rad.is_some() && log.ud_v.is_some() && log.uq_v.is_some() {
+        p.push(Predictor::Electrical);
+    }
+    p
+}
+
+/// Predictions by signal: the subsystem replays' (what the diagnosis decides on) and the
+/// closed loop's.
+#[derive(Clone, Debug, Default)]
+pub struct Predictions {
+    /// Subsystem replays by signal.
+    pub subsystem: BTreeMap<&'static str, Vec<f64>>,
+    /// Closed-loop replay by signal (empty when the log has no usable setpoint).
+    pub closed_loop: BTreeMap<&'static str, Vec<f64>>,
+}
+
+impl Predictions {
+    /// The contract's per-signal predictions: pressure and voltages from the subsystem
+    /// replays (driven by the logged angle and currents), speed and currents from the
+    /// closed loop, which predicts them (the subsystem replays take them as inputs); the
+    /// motor replay's speed and needed current when there is no closed loop.
+    pub fn contract(&self) -> BTreeMap<&'static str, Vec<f64>> {
+        let mut out = self.subsystem.clone();
+        for (k, v) in &self.closed_loop {
+            if *k != "p_pa" {
+                out.insert(k, v.clone());
+            }
+        }
+        out
+    }
+}
+
+/// Every prediction on `rig`.
+fn predict_all(
+    log: &BenchLog,
+    rig: &Rig,
+    phase_a_offset_a: f64,
+) -> Result<Predictions, ReplayError> {
+    let preds: Vec<Result<Predicted, ReplayError>> = predictors(log)
+        .into_par_iter()
+        .map(|p| predict(log, rig, p, usize::MAX, phase_a_offset_a))
+        .collect();
+    let mut out = Predictions::default();
+    for p in preds {
+        for (name, y) in p? {
+            out.subsystem.insert(name, y);
+        }
+    }
+    if let Some(cl) = replay_closed_loop(log, rig) {
+        out.closed_loop.insert("p_pa", cl.p_pa);
+        out.closed_loop.insert("speed_rad_s", cl.speed_rad_s);
+        out.closed_loop.insert("iq_a", cl.iq_a);
+        out.closed_loop.insert("id_a", cl.id_a);
+    }
+    Ok(out)
+}
+
+/// Fit per signal over `rows`.
+fn fits_over(
+    log: &BenchLog,
+    predicted: &BTreeMap<&'static str, Vec<f64>>,
+    rows: std::ops::Range<usize>,
+) -> BTreeMap<String, f64> {
+    predicted
+        .iter()
+        .filter_map(|(name, y_hat)| {
+            let y = column(log, name)?;
+            let f = fit_percent(&y[rows.clone()], y_hat.get(rows.clone())?)?;
+            Some((name.to_string(), f))
+        })
+        .collect()
+}
+
+fn rmse(y: &[f64], y_hat: &[f64]) -> f64 {
+    let n = y.len().min(y_hat.len()).max(1);
+    (y.iter()
+        .zip(y_hat)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        / n as f64)
+        .sqrt()
+}
+
+fn fit_of(
+    log: &BenchLog,
+    predicted: &BTreeMap<&'static str, Vec<f64>>,
+    rows: std::ops::Range<usize>,
+) -> Fit {
+    let by = fits_over(log, predicted, rows.clone());
+    Fit {
+        fit_percent: by.get("p_pa").copied().unwrap_or(f64::NAN),
+        rmse_pa: predicted
+            .get("p_pa")
+            .map_or(f64::NAN, |p| rmse(&log.p_pa[rows.clone()], &p[rows])),
+        fit_percent_by_signal: by,
+    }
+}
+
+/// Runs the whole analysis.
+pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
+    log.check(Path::new("bench log being diagnosed"))
+        .map_err(ReplayError::from)?;
+    rig.validate().map_err(ReplayError::from)?;
+    let n = log.len();
+    let t = &log.t_s;
+    // 1. Segments.
+    let t_mid = t[0] + 0.5 * (t[n - 1] - t[0]);
+    let t_split = t_mid.min(t[0] + MAX_IDENTIFICATION_S);
+    let split = t.partition_point(|x| *x < t_split).clamp(2, n - 1);
+    let from = INITIAL_SAMPLES.min(split / 4);
+    // 2. Baseline.
+    let base_pred = predict_all(log, rig, 0.0)?;
+    let baseline = base_pred.subsystem.clone();
+    let measured: BTreeMap<&'static str, Vec<f64>> = base_pred
+        .contract()
+        .keys()
+        .filter_map(|k| Some((*k, column(log, k)?.to_vec())))
+        .collect();
+    // 3. Evidence: order spectra of the residuals.
+    let theta = log.theta_m_rad.as_deref().map(unwrap_angle);
+    let mut spectra = Vec::new();
+    if let Some(th) = &theta {
+        for name in ["p_pa", "speed_rad_s"] {
+            if let (Some(y), Some(y_hat)) = (measured.get(name), baseline.get(name)) {
+                let r: Vec<f64> = y.iter().zip(y_hat).map(|(a, b)| a - b).collect();
+                if let Some(s) = order_spectrum(&th[from..], &r[from..]) {
+                    spectra.push((name, s));
+                }
+            }
+        }
+    }
+    let pp = rig.motor.pole_pairs;
+    let lcm = rig.motor.cogging_fundamental_order();
+    let mut cogging_orders = vec![lcm];
+    if let Some((_, s)) = spectra.iter().find(|(n, _)| *n == "speed_rad_s") {
+        // A strong line at an order the other angle-locked effects cannot make is a
+        // cogging order the rig file does not predict.
+        let floor = s.floor(2, 200);
+        if let Some((k, a)) = s.strongest(2, 200) {
+            if k % pp != 0 && k != lcm && a > 6.0 * floor {
+                cogging_orders.push(k);
+            }
+        }
+    }
+    // 4. Candidates fitted on the identification rows.
+    let cands = candidates(rig, theta.is_some(), piston_moves(log), &cogging_orders);
+    let baseline_sse: BTreeMap<Predictor, Vec<(&'static str, f64)>> = predictors(log)
+        .into_iter()
+        .map(|p| {
+            let pred: Predicted = p
+                .signals()
+                .iter()
+                .filter_map(|s| Some((*s, baseline.get(s)?.clone())))
+                .collect();
+            let target = Target {
+                log,
+                rig,
+                rows: split,
+                from,
+                baseline_sse: Vec::new(),
+            };
+            (p, target.sse(&pred))
+        })
+        .collect();
+    let usable: Vec<&Candidate> = cands
+        .iter()
+        .filter(|c| {
+            baseline_sse
+                .get(&c.predictor)
+                .is_some_and(|v| !v.is_empty())
+        })
+        .collect();
+    let mut fits: Vec<CandidateFit> = usable
+        .par_iter()
+        .map(|c| {
+            let target = Target {
+                log,
+                rig,
+                rows: split,
+                from,
+                baseline_sse: baseline_sse[&c.predictor].clone(),
+            };
+            fit(&target, c)
+        })
+        .collect();
+    fits.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+    // 5. Keep the best fault that validates.
+    let val = split..n;
+    let base_val = fits_over(log, &baseline, val.clone());
+    let mut kept: Option<(usize, Predictions)> = None;
+    let mut notes: BTreeMap<usize, String> = BTreeMap::new();
+    for (i, f) in fits.iter().enumerate() {
+        if 1.0 - f.cost < MIN_EXPLAINED {
+            break;
+        }
+        if !f.candidate.is_significant(&f.u, rig) {
+            notes.insert(i, "within the rig's tolerances".into());
+            continue;
+        }
+        let mut ext_rig = rig.clone();
+        f.candidate.effect(&f.u, rig).apply(&mut ext_rig);
+        let ext = predict_all(log, &ext_rig, f.candidate.phase_a_offset_a(&f.u))?;
+        let ext_val = fits_over(log, &ext.subsystem, val.clone());
+        let gain = f
+            .candidate
+            .predictor
+            .signals()
+            .iter()
+            .filter_map(|s| Some(ext_val.get(*s)? - base_val.get(*s)?))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if gain >= MIN_VALIDATION_GAIN_POINTS {
+            kept = Some((i, ext));
+            break;
+        }
+        notes.insert(
+            i,
+            format!("does not improve the validation segment ({gain:+.1} points)"),
+        );
+    }
+    // Causes, ranked.
+    let best_explained = fits.first().map_or(0.0, |f| 1.0 - f.cost);
+    let mut causes = Vec::new();
+    let describe = |f: &CandidateFit| {
+        let signals = f.candidate.predictor.signals().join(", ");
+        let mut s = format!(
+            "removes {:.0} % of the nominal model's squared error in {} ({}) on the identification segment",
+            100.0 * (1.0 - f.cost),
+            signals,
+            f.candidate.predictor.describe()
+        );
+        if let Some(line) = order_evidence(&f.candidate, &spectra, rig) {
+            s.push_str("; ");
+            s.push_str(&line);
+        }
+        s
+    };
+    let none_cause = |score: f64, why: String| Cause {
+        effect: "none".into(),
+        score,
+        parameters: BTreeMap::new(),
+        evidence: why,
+    };
+    if let Some((i, _)) = &kept {
+        let f = &fits[*i];
+        causes.push(cause_of(f, rig, describe(f)));
+    } else {
+        causes.push(none_cause(
+            1.0 - best_explained,
+            "no effect of the catalogue beyond the rig's tolerances improves the validation segment"
+                .into(),
+        ));
+    }
+    // The other candidates, best first, one entry per effect.
+    for (i, f) in fits.iter().enumerate() {
+        if kept.as_ref().is_some_and(|(k, _)| *k == i)
+            || causes.iter().any(|c| c.effect == f.candidate.name)
+        {
+            continue;
+        }
+        let mut why = describe(f);
+        if let Some(n) = notes.get(&i) {
+            why.push_str("; ");
+            why.push_str(n);
+        }
+        causes.push(cause_of(f, rig, why));
+    }
+    if kept.is_some() {
+        causes.push(none_cause(
+            0.0,
+            "the kept extension improves the validation segment".into(),
+        ));
+    }
+    let base_contract = base_pred.contract();
+    let base_fit = fit_of(log, &base_contract, val.clone());
+    let (ext_effects, ext_pred) = match kept {
+        Some((i, ext)) => (vec![fits[i].candidate.name.to_string()], ext.contract()),
+        None => (Vec::new(), base_contract.clone()),
+    };
+    let ext_fit = fit_of(log, &ext_pred, val.clone());
+    let diagnosis = Diagnosis {
+        samples: n,
+        identification_segment_s: [t[0], t[split - 1]],
+        validation_segment_s: [t[split], t[n - 1]],
+        gain: Gain {
+            fit_points: ext_fit.fit_percent - base_fit.fit_percent,
+            rmse_reduction_percent: 100.0 * (1.0 - ext_fit.rmse_pa / base_fit.rmse_pa),
+        },
+        baseline: base_fit,
+        causes,
+        extended: Extended {
+            effects: ext_effects,
+            fit_percent: ext_fit.fit_percent,
+            rmse_pa: ext_fit.rmse_pa,
+            fit_percent_by_signal: ext_fit.fit_percent_by_signal,
+        },
+    };
+    let candidate_orders = candidate_orders(rig, &cogging_orders);
+    Ok(Analysis {
+        diagnosis,
+        t_s: t.clone(),
+        measured,
+        baseline: base_contract,
+        extended: ext_pred,
+        spectra,
+        candidate_orders,
+        fits,
+    })
+}
+
+fn cause_of(f: &CandidateFit, rig: &Rig, evidence: String) -> Cause {
+    Cause {
+        effect: f.candidate.name.into(),
+        score: (1.0 - f.cost).max(0.0),
+        parameters: f
+            .candidate
+            .parameters(&f.u, rig)
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect(),
+        evidence,
+    }
+}
+
+/// The angle-locked orders each effect would show at.
+fn candidate_orders(rig: &Rig, cogging: &[u32]) -> Vec<(u32, &'static str)> {
+    let pp = rig.motor.pole_pairs;
+    let mut v = vec![
+        (pp, "current_sensor_offset"),
+        (6 * pp, "flux_harmonics"),
+        (2 * rig.pump.pistons, "piston_ripple"),
+    ];
+    v.extend(cogging.iter().map(|k| (*k, "cogging_torque")));
+    v
+}
+
+/// A line of evidence from the residual spectrum for an angle-locked candidate.
+fn order_evidence(
+    c: &Candidate,
+    spectra: &[(&'static str, OrderSpectrum)],
+    rig: &Rig,
+) -> Option<String> {
+    let pp = rig.motor.pole_pairs;
+    let (signal, order) = match (c.name, c.structure) {
+        ("cogging_torque", super::candidates::Structure::Order(k)) => ("speed_rad_s", k),
+        ("flux_harmonics", _) => ("speed_rad_s", 6 * pp),
+        ("current_sensor_offset", _) => ("speed_rad_s", pp),
+        ("piston_ripple", super::candidates::Structure::Pistons(z)) => {
+            ("p_pa", if z % 2 == 1 { 2 * z } else { z })
+        }
+        _ => return None,
+    };
+    let (_, s) = spectra.iter().find(|(n, _)| *n == signal)?;
+    let floor = s.floor(1, 200);
+    Some(format!(
+        "residual {signal} line at order {order}: {:.3e} ({:.1}× the spectrum's median line)",
+        s.at(order),
+        s.at(order) / floor.max(f64::MIN_POSITIVE)
+    ))
+}

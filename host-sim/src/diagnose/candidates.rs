@@ -1,0 +1,299 @@
+//! The catalogue's effects (`shared/contracts/effects.md`) as candidate explanations: which
+//! subsystem replay each shows in, how its parameters are searched, and how large it must
+//! be to count as a fault rather than the rig's ordinary tolerances.
+//!
+//! Each candidate maps a search vector `u` (unbounded, about unit scale) to the effect's
+//! parameters, so one optimiser serves them all: positive quantities are searched in
+//! logarithm (their plausible ranges span decades), signed ones linearly, phases as angles.
+
+use super::predict::Predictor;
+use plant_model::{Effect, Rig};
+use std::f64::consts::PI;
+
+/// One candidate effect with its search space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Candidate {
+    /// Effect name (the contract's).
+    pub name: &'static str,
+    /// The replay it shows in.
+    pub predictor: Predictor,
+    /// Fixed structure the search does not vary (pistons, cogging order).
+    pub structure: Structure,
+    /// Start of the search. [search units]
+    pub start: Vec<f64>,
+    /// Initial simplex step per search coordinate. [search units]
+    pub step: Vec<f64>,
+    /// Coarse grid over the first coordinate, tried before the simplex so it starts in the
+    /// right basin (pressure and friction responses are far from linear). [search units]
+    pub grid: Vec<f64>,
+}
+
+/// The part of a candidate that is chosen, not fitted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Structure {
+    /// Nothing.
+    None,
+    /// Pump pistons z.
+    Pistons(u32),
+    /// Cogging order per revolution.
+    Order(u32),
+}
+
+/// Nominal leakage of the rig's high-pressure side, the scale of `extra_leakage`.
+/// [(m³/s)/Pa]
+fn nominal_leakage(rig: &Rig) -> f64 {
+    rig.pump.internal_leakage_m3_s_pa + rig.pump.external_leakage_m3_s_pa
+}
+
+/// The kinematic peak-to-peak flow ripple over mean flow of an axial piston pump with `z`
+/// pistons (eq. 21): (π/2z)·tan(π/4z) for odd z, (π/z)·tan(π/2z) for even z (1.52 % for
+/// z = 9, 7.8 % for z = 8).
+pub fn kinematic_ripple_ratio(z: u32) -> f64 {
+    let z = z.max(1) as f64;
+    if z as u32 % 2 == 1 {
+        PI / (2.0 * z) * (PI / (4.0 * z)).tan()
+    } else {
+        PI / z * (PI / (2.0 * z)).tan()
+    }
+}
+
+impl Candidate {
+    /// The effect at search point `u` on `rig`.
+    pub fn effect(&self, u: &[f64], rig: &Rig) -> Effect {
+        let g = |k: usize| u.get(k).copied().unwrap_or(0.0);
+        match self.name {
+            "piston_ripple" => {
+                let z = match self.structure {
+                    Structure::Pistons(z) => z,
+                    _ => rig.pump.pistons,
+                };
+                Effect::PistonRipple {
+                    pistons: z,
+                    amplitude_ratio: (kinematic_ripple_ratio(z) * g(0).exp()).min(0.9),
+                }
+            }
+            "cogging_torque" => Effect::CoggingTorque {
+                amplitude_nm: 0.05 * g(0).exp(),
+                order: match self.structure {
+                    Structure::Order(k) => k,
+                    _ => 0,
+                },
+                phase_rad: wrap_pi(g(1)),
+            },
+            "flux_harmonics" => Effect::FluxHarmonics {
+                t6_ratio: 0.02 * g(0).exp(),
+                phase_rad: wrap_pi(g(1)),
+            },
+            "dead_time" => Effect::DeadTime {
+                dead_time_s: 1e-6 * g(0).exp(),
+            },
+            "shaft_friction" => {
+                let c = 0.05 * g(0).exp();
+                Effect::ShaftFriction {
+                    coulomb_nm: c,
+                    static_nm: c * (1.0 + g(1).exp()),
+                }
+            }
+            "cylinder_friction" => {
+                let c = 300.0 * g(0).exp();
+                Effect::CylinderFriction {
+                    coulomb_n: c,
+                    static_n: c * (1.0 + g(1).exp()),
+                }
+            }
+            "extra_leakage" => Effect::ExtraLeakage {
+                coefficient_m3_s_pa: nominal_leakage(rig) * g(0).exp(),
+            },
+            "entrained_air" => Effect::EntrainedAir {
+                effective_bulk_modulus_pa: rig.oil.bulk_modulus_pa / (1.0 + g(0).exp()),
+            },
+            "accumulator_precharge" => Effect::AccumulatorPrecharge {
+                precharge_pa: rig.absorber.precharge_pa * g(0).exp(),
+            },
+            "pressure_sensor_lag" => Effect::PressureSensorLag {
+                time_constant_s: 5e-3 * g(0).exp(),
+            },
+            "current_sensor_offset" => Effect::CurrentSensorOffset {
+                offset_a: 0.5 * g(0),
+            },
+            _ => Effect::None,
+        }
+    }
+
+    /// The current-sensor offset the motor replay must assume at `u`. [A]
+    pub fn phase_a_offset_a(&self, u: &[f64]) -> f64 {
+        if self.name == "current_sensor_offset" {
+            0.5 * u.first().copied().unwrap_or(0.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Whether the effect at `u` is beyond what the rig's ordinary tolerances (a few percent
+    /// on every parameter) can produce, i.e. a fault worth naming. The thresholds are the
+    /// size of the smallest effect of each kind a rig's tolerances cannot mimic.
+    pub fn is_significant(&self, u: &[f64], rig: &Rig) -> bool {
+        match self.effect(u, rig) {
+            Effect::PistonRipple {
+                amplitude_ratio, ..
+            } => amplitude_ratio > 0.003,
+            Effect::CoggingTorque { amplitude_nm, .. } => amplitude_nm > 0.01,
+            Effect::FluxHarmonics { t6_ratio, .. } => t6_ratio > 0.008,
+            Effect::DeadTime { dead_time_s } => dead_time_s > 0.2e-6,
+            Effect::ShaftFriction { coulomb_nm, .. } => coulomb_nm > 0.02,
+            Effect::CylinderFriction { coulomb_n, .. } => coulomb_n > 100.0,
+            Effect::ExtraLeakage {
+                coefficient_m3_s_pa,
+            } => coefficient_m3_s_pa > 0.3 * nominal_leakage(rig),
+            Effect::EntrainedAir {
+                effective_bulk_modulus_pa,
+            } => effective_bulk_modulus_pa < 0.85 * rig.oil.bulk_modulus_pa,
+            Effect::AccumulatorPrecharge { precharge_pa } => {
+                (precharge_pa / rig.absorber.precharge_pa).ln().abs() > 0.15
+            }
+            Effect::PressureSensorLag { time_constant_s } => time_constant_s > 1e-3,
+            Effect::CurrentSensorOffset { offset_a } => offset_a.abs() > 0.08,
+            Effect::None => false,
+        }
+    }
+
+    /// The fitted parameters by the catalogue's names (SI).
+    pub fn parameters(&self, u: &[f64], rig: &Rig) -> Vec<(&'static str, f64)> {
+        let mut e = self.effect(u, rig);
+        // The catalogue's cogging order 0 means "the rig's"; report the number.
+        if let Effect::CoggingTorque { order, .. } = &mut e {
+            if *order == 0 {
+                *order = rig.motor.cogging_fundamental_order();
+            }
+        }
+        e.parameters().into_iter().flatten().collect()
+    }
+}
+
+/// Wraps an angle to (−π, π]. [rad]
+pub fn wrap_pi(a: f64) -> f64 {
+    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
+    if w <= -PI {
+        w + 2.0 * PI
+    } else {
+        w
+    }
+}
+
+fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|k| lo + (hi - lo) * k as f64 / (n - 1).max(1) as f64)
+        .collect()
+}
+
+/// Every candidate the log can show, given which predictors it supports and the orders the
+/// residual spectrum points at (`cogging_orders`; the rig's slot/pole order when empty).
+pub fn candidates(
+    rig: &Rig,
+    has_angle: bool,
+    piston_moves: bool,
+    cogging_orders: &[u32],
+) -> Vec<Candidate> {
+    let one = |name, predictor, grid: Vec<f64>, dims: usize| Candidate {
+        name,
+        predictor,
+        structure: Structure::None,
+        start: vec![0.0; dims],
+        step: vec![0.5; dims],
+        grid,
+    };
+    let mut out = vec![
+        // Search units: ln(coefficient / nominal leakage), from 1/20 to 20 times nominal.
+        one(
+            "extra_leakage",
+            Predictor::Hydraulics,
+            log_grid(-3.0, 3.0, 7),
+            1,
+        ),
+        // ln(β_nom/β − 1): β from 95 % down to 5 % of nominal.
+        one(
+            "entrained_air",
+            Predictor::Hydraulics,
+            log_grid(-3.0, 3.0, 7),
+            1,
+        ),
+        // ln(p0/p0_nom): a fifth to five times nominal.
+        one(
+            "accumulator_precharge",
+            Predictor::Hydraulics,
+            log_grid(-1.6, 1.6, 9),
+            1,
+        ),
+        // ln(τ/5 ms): 0.25 ms to 100 ms.
+        one(
+            "pressure_sensor_lag",
+            Predictor::Hydraulics,
+            log_grid(-3.0, 3.0, 7),
+            1,
+        ),
+        // ln(T_c/0.05 N·m), ln(T_s/T_c − 1).
+        one(
+            "shaft_friction",
+            Predictor::Motor,
+            log_grid(-2.5, 2.5, 6),
+            2,
+        ),
+    ];
+    if piston_moves {
+        // ln(F_c/300 N): 25 N to 5 kN.
+        out.push(one(
+            "cylinder_friction",
+            Predictor::Hydraulics,
+            log_grid(-2.5, 2.8, 7),
+            2,
+        ));
+    }
+    if has_angle {
+        out.push(one(
+            "dead_time",
+            Predictor::Electrical,
+            log_grid(-3.0, 1.6, 7),
+            1,
+        ));
+        // Offset / 0.5 A, both signs up to 2 A.
+        out.push(one(
+            "current_sensor_offset",
+            Predictor::Motor,
+            vec![-4.0, -2.0, -1.0, -0.4, 0.4, 1.0, 2.0, 4.0],
+            1,
+        ));
+        // ln(T6/0.02), phase: the grid is over the phase at a mid amplitude; the simplex
+        // then moves both.
+        let mut flux = one("flux_harmonics", Predictor::Motor, Vec::new(), 2);
+        flux.grid = log_grid(-PI, PI * 0.75, 8);
+        out.push(flux);
+        let orders: Vec<u32> = if cogging_orders.is_empty() {
+            vec![rig.motor.cogging_fundamental_order()]
+        } else {
+            cogging_orders.to_vec()
+        };
+        for k in orders {
+            let mut c = one("cogging_torque", Predictor::Motor, Vec::new(), 2);
+            c.structure = Structure::Order(k);
+            c.grid = log_grid(-PI, PI * 0.75, 8);
+            out.push(c);
+        }
+        for z in [7, 9, 11] {
+            let mut c = one(
+                "piston_ripple",
+                Predictor::Hydraulics,
+                log_grid(-1.0, 1.5, 6),
+                1,
+            );
+            c.structure = Structure::Pistons(z);
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Whether a candidate's grid runs over the phase (second coordinate) rather than the
+/// magnitude.
+pub fn grid_is_phase(c: &Candidate) -> bool {
+    matches!(c.name, "cogging_torque" | "flux_harmonics")
+}

@@ -1,0 +1,202 @@
+//! `eha diagnose --report DIR`: a short markdown report with SVG plots — measured against
+//! simulated before and after the extension on the leading cause's signals, the residual
+//! order spectra with the candidates' orders marked, and the ranking with its evidence.
+//!
+//! Every file is rendered into a staging folder next to DIR and moved in only when all
+//! of them are written, so a failure leaves DIR as it was.
+
+use super::analysis::Analysis;
+use super::predict::Predictor;
+use crate::cli::CliError;
+use crate::plots::{line_chart, Marker, Series};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Points per trace in a plot (the SVG stays small on long logs).
+const MAX_POINTS: usize = 4000;
+
+fn decimated(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    let step = (t.len() / MAX_POINTS).max(1);
+    t.iter()
+        .zip(y)
+        .step_by(step)
+        .map(|(a, b)| (*a, *b))
+        .collect()
+}
+
+fn failed(what: &str, e: impl std::fmt::Display) -> CliError {
+    CliError::Failed(format!("report: {what}: {e}"))
+}
+
+/// Writes the report of `analysis` (of the log at `log_path`) into `dir`.
+pub fn write_report(dir: &Path, log_path: &Path, analysis: &Analysis) -> Result<(), CliError> {
+    let parent = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| failed(&parent.display().to_string(), e))?;
+    let name = dir
+        .file_name()
+        .map_or("report".into(), |n| n.to_string_lossy().to_string());
+    let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&staging);
+    std::fs::create_dir_all(&staging).map_err(|e| failed(&staging.display().to_string(), e))?;
+    let result = render(&staging, log_path, analysis).and_then(|files| {
+        std::fs::create_dir_all(dir).map_err(|e| failed(&dir.display().to_string(), e))?;
+        for f in files {
+            std::fs::rename(staging.join(&f), dir.join(&f))
+                .map_err(|e| failed(&dir.join(&f).display().to_string(), e))?;
+        }
+        Ok(())
+    });
+    let _ = std::fs::remove_dir_all(&staging);
+    result
+}
+
+fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliError> {
+    let d = &a.diagnosis;
+    let mut files = Vec::new();
+    let mut md = String::new();
+    let lead = &d.causes[0];
+    let _ = writeln!(md, "# Diagnosis of `{}`\n", log_path.display());
+    let _ = writeln!(
+        md,
+        "**Cause: `{}`** — {}\n\n{} samples; identification segment {:.3}–{:.3} s (the fit), \
+         validation segment {:.3}–{:.3} s (the scores below; the fit never saw it).\n",
+        lead.effect,
+        lead.evidence,
+        d.samples,
+        d.identification_segment_s[0],
+        d.identification_segment_s[1],
+        d.validation_segment_s[0],
+        d.validation_segment_s[1]
+    );
+    let _ = writeln!(
+        md,
+        "| signal | baseline fit [%] | extended fit [%] |\n|---|---|---|"
+    );
+    for (s, b) in &d.baseline.fit_percent_by_signal {
+        let e = d.extended.fit_percent_by_signal.get(s).copied();
+        let _ = writeln!(md, "| `{s}` | {b:.1} | {:.1} |", e.unwrap_or(f64::NAN));
+    }
+    let _ = writeln!(
+        md,
+        "\nPressure RMSE: {:.0} Pa → {:.0} Pa ({:+.1} % reduction).\n",
+        d.baseline.rmse_pa, d.extended.rmse_pa, d.gain.rmse_reduction_percent
+    );
+    let _ = writeln!(
+        md,
+        "## Ranking\n\n| rank | effect | score | parameters | evidence |\n|---|---|---|---|---|"
+    );
+    for (k, c) in d.causes.iter().enumerate() {
+        let params: Vec<String> = c
+            .parameters
+            .iter()
+            .map(|(n, v)| format!("{n} = {v:.4}"))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {} | `{}` | {:.3} | {} | {} |",
+            k + 1,
+            c.effect,
+            c.score,
+            params.join(", "),
+            c.evidence
+        );
+    }
+    // Traces of the lead cause's signals (pressure and speed when none).
+    let signals: Vec<&'static str> = a
+        .fits
+        .iter()
+        .find(|f| f.candidate.name == lead.effect)
+        .map(|f| f.candidate.predictor.signals().to_vec())
+        .unwrap_or_else(|| {
+            let mut v = Predictor::Hydraulics.signals().to_vec();
+            v.extend(Predictor::Motor.signals());
+            v
+        });
+    let _ = writeln!(md, "\n## Measured and simulated\n");
+    for s in signals {
+        let (Some(y), Some(b), Some(e)) = (a.measured.get(s), a.baseline.get(s), a.extended.get(s))
+        else {
+            continue;
+        };
+        let file = format!("trace_{s}.svg");
+        line_chart(
+            &dir.join(&file),
+            &format!("{s}: measured, nominal model, extended model"),
+            "t [s]",
+            s,
+            &[
+                Series {
+                    name: "measured",
+                    points: decimated(&a.t_s, y),
+                },
+                Series {
+                    name: "nominal model",
+                    points: decimated(&a.t_s, b),
+                },
+                Series {
+                    name: "extended model",
+                    points: decimated(&a.t_s, e),
+                },
+            ],
+            &[Marker {
+                x: d.validation_segment_s[0],
+                label: "validation →",
+            }],
+            false,
+        )
+        .map_err(|e| failed(&file, e))?;
+        let _ = writeln!(md, "![{s}]({file})\n");
+        files.push(file);
+    }
+    let _ = writeln!(md, "## Residual order spectra (nominal model)\n");
+    let labels: Vec<String> = a
+        .candidate_orders
+        .iter()
+        .map(|(k, name)| format!("{k}: {name}"))
+        .collect();
+    for (s, spec) in &a.spectra {
+        let file = format!("residual_spectrum_{s}.svg");
+        let points: Vec<(f64, f64)> = spec
+            .amplitude
+            .iter()
+            .enumerate()
+            .skip(1)
+            .take(200)
+            .map(|(k, v)| (k as f64, *v))
+            .collect();
+        let markers: Vec<Marker> = a
+            .candidate_orders
+            .iter()
+            .zip(&labels)
+            .map(|((k, _), l)| Marker {
+                x: *k as f64,
+                label: l,
+            })
+            .collect();
+        line_chart(
+            &dir.join(&file),
+            &format!(
+                "{s} residual against shaft angle ({} revolutions)",
+                spec.revolutions
+            ),
+            "order [cycles per revolution]",
+            "amplitude",
+            &[Series {
+                name: "residual",
+                points,
+            }],
+            &markers,
+            true,
+        )
+        .map_err(|e| failed(&file, e))?;
+        let _ = writeln!(md, "![{s} residual spectrum]({file})\n");
+        files.push(file);
+    }
+    crate::atomic_file::write(&dir.join("report.md"), md.as_bytes())
+        .map_err(|e| failed("report.md", e))?;
+    files.push("report.md".into());
+    Ok(files)
+}
