@@ -43,8 +43,8 @@
 //! [`ParamStore::load`] takes the valid record with the larger sequence number. Without
 //! one, the outcome says why: both pages blank (never saved: defaults, no fault), or a
 //! record that is corrupt or of another format version or table (defaults and fault 16,
-//! [`crate::FaultCode::ParameterStoreInvalid`]). [`boot_config`] also refuses a
-//! record whose values are out of their bounds or inconsistent, so the controller never
+//! [`crate::FaultCode::ParameterStoreInvalid`]). [`boot`] and [`boot_config`] also refuse
+//! a record whose values are out of their bounds or inconsistent, so the controller never
 //! starts from garbage.
 
 use crate::config::Config;
@@ -284,29 +284,35 @@ impl BootOutcome {
     }
 }
 
+/// Boot: loads the newest table and hands it to `apply` (which checks and applies it,
+/// returning false when it refuses it). A record `apply` refuses counts as invalid.
+pub fn boot<F: NorFlash>(
+    store: &mut ParamStore<F>,
+    apply: impl FnOnce(&[f32; COUNT]) -> bool,
+) -> BootOutcome {
+    match store.load() {
+        (Some(v), LoadOutcome::Loaded { sequence }) => {
+            if apply(&v) {
+                BootOutcome::Stored { sequence }
+            } else {
+                BootOutcome::DefaultsAfterInvalid(LoadOutcome::Corrupt)
+            }
+        }
+        (_, LoadOutcome::Blank) => BootOutcome::Defaults,
+        (_, other) => BootOutcome::DefaultsAfterInvalid(other),
+    }
+}
+
 /// The configuration to boot with: `defaults` with the stored table applied, or
 /// `defaults` alone when nothing usable is stored. A record whose values fail their
-/// bounds or [`Config::validate`] counts as invalid.
+/// bounds or the cross-checks counts as invalid.
 pub fn boot_config<F: NorFlash>(
     store: &mut ParamStore<F>,
     defaults: &Config,
 ) -> (Config, BootOutcome) {
-    let (values, outcome) = store.load();
     let mut cfg = *defaults;
-    match (values, outcome) {
-        (Some(v), LoadOutcome::Loaded { sequence }) => {
-            if parameters::apply_all(&mut cfg, &v).is_ok() {
-                (cfg, BootOutcome::Stored { sequence })
-            } else {
-                (
-                    *defaults,
-                    BootOutcome::DefaultsAfterInvalid(LoadOutcome::Corrupt),
-                )
-            }
-        }
-        (_, LoadOutcome::Blank) => (cfg, BootOutcome::Defaults),
-        (_, other) => (cfg, BootOutcome::DefaultsAfterInvalid(other)),
-    }
+    let outcome = boot(store, |v| parameters::apply_all(&mut cfg, v).is_ok());
+    (cfg, outcome)
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use firmware::can_protocol::{
     encode_set_parameter, Frame, NodeId, RejectReason, Rejection, Reply, Request,
 };
 use firmware::can_server::{serve, Response};
-use firmware::param_store::{boot_config, BootOutcome, ParamStore};
+use firmware::param_store::{boot, boot_config, BootOutcome, ParamStore};
 use firmware::parameters::{ParamId, COUNT};
 use firmware::{Command, Config, Controller, Mode};
 
@@ -228,10 +228,12 @@ fn a_table_set_over_can_and_saved_is_there_after_a_reboot() {
     assert_eq!(values.len(), COUNT);
     store.save(&values).expect("saved");
 
-    // Reboot: a new controller from the stored table.
-    let (cfg, outcome) = boot_config(&mut store, &Config::nominal());
+    // Reboot as the application does: the nominal controller, then the stored table.
+    let mut rebooted = Controller::new(&Config::nominal());
+    let outcome = boot(&mut store, |v| rebooted.load_parameters(v).is_ok());
     assert_eq!(outcome, BootOutcome::Stored { sequence: 1 });
-    let mut rebooted = Controller::new(&cfg);
+    let (cfg, _) = boot_config(&mut store, &Config::nominal());
+    assert_eq!(*rebooted.config(), cfg);
     for (p, v) in [
         (ParamId::SpeedKp, 0.2),
         (ParamId::AbsorberPrechargePa, 2.5e6),

@@ -11,7 +11,7 @@
 //!
 //! Start-up: configuration validated (on error the bridge stays off and the error is
 //! logged), peripherals brought up with the bridge disabled, the stored parameter table
-//! applied over the defaults ([`firmware::param_store::boot_config`]: a corrupt,
+//! applied over the defaults ([`firmware::param_store::boot`]: a corrupt,
 //! other-version or inconsistent record gives the defaults and latches fault 16), the
 //! drive installed, the interrupt enabled, the tasks spawned. The drive starts in Disabled; a CAN `SetMode`
 //! command starts it.
@@ -29,7 +29,7 @@ use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_time::Timer;
 use firmware::can_protocol::NodeId;
-use firmware::param_store::{boot_config, BootOutcome};
+use firmware::param_store::{boot, BootOutcome};
 use firmware::{Config, Controller};
 use panic_probe as _;
 
@@ -69,8 +69,10 @@ async fn main(spawner: Spawner) {
         Ok(s) => s,
         Err(_) => defmt::panic!("parameter pages do not fit the flash layout"),
     };
-    let (config, outcome) = boot_config(&mut store, &config);
+    // Built from the constant nominal configuration, then given the stored table: the
+    // constructor folds at compile time, the table goes through the live-parameter path.
     let mut controller = Controller::new(&config);
+    let outcome = boot(&mut store, |v| controller.load_parameters(v).is_ok());
     match outcome {
         BootOutcome::Stored { sequence } => {
             defmt::info!("parameters: stored table {} loaded", sequence)
@@ -81,6 +83,7 @@ async fn main(spawner: Spawner) {
             controller.report_parameter_store_invalid();
         }
     }
+    let decimation = controller.telemetry_decimation();
     control::install(controller, Bridge::new(b.power), Sensors::new(b.sensors));
     board::enable_current_loop_interrupt();
     defmt::info!(
@@ -88,7 +91,7 @@ async fn main(spawner: Spawner) {
         pwm_hz,
         node.get(),
         board::CAN_BITRATE,
-        config.rates.telemetry_decimation
+        decimation
     );
 
     let (tx, rx) = can_link::split(b.can.into_normal_mode());
