@@ -199,6 +199,11 @@ fn cut_everywhere(before: &[[f32; COUNT]]) -> usize {
         rebooted.save(&again).unwrap();
         assert_eq!(rebooted.load().0, Some(again), "save after cut {cut}");
     }
+    println!(
+        "{} saves before: {} cut points (erase {PAGE} B, record {RECORD_LEN} B, commit {COMMIT_LEN} B), each reloads the previous table",
+        before.len(),
+        total + 1
+    );
     total + 1
 }
 
