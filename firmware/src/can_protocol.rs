@@ -9,8 +9,9 @@
 //! # Identifiers
 //!
 //! `id = function base + node`, with the node number in the low 4 bits (0‥15, so up to 16
-//! drives share one bus) and the function in the upper 7 bits. Commands have lower
-//! identifiers than replies, so on a busy bus they win arbitration.
+//! drives share one bus) and the function in the upper 7 bits. The real-time commands
+//! (`0x100`‥`0x140`) have lower identifiers than the replies, so on a busy bus they win
+//! arbitration.
 //!
 //! | base    | direction    | name           | DLC | payload (little endian)                 |
 //! |---------|--------------|----------------|-----|-----------------------------------------|
@@ -49,7 +50,8 @@
 //!
 //! # Status (`0x180 + node`, DLC 8)
 //!
-//! Sent periodically and after every accepted command.
+//! Sent periodically and after every accepted command (except a heartbeat, and the
+//! parameter commands answered by a `Parameter` frame).
 //!
 //! | bytes | type  | content                                                          |
 //! |-------|-------|------------------------------------------------------------------|
@@ -69,13 +71,13 @@
 //! | 0     | `u8`  | function code of the refused command (identifier base >> 4, e.g. `0x11` for `SetPressure`) |
 //! | 1     | `u8`  | reason code ([`RejectReason`])                                   |
 //! | 2‥5   | `i32` | the bound that was violated, in the command's wire unit (Pa, mrad/s, mode code or DLC); `0` when the reason has no bound |
-//! | 6‥7   | —     | reserved, `0`                                                    |
+//! | 6     | `u8`  | parameter id (or unknown code) the refusal concerns, `0` for none |
+//! | 7     | —     | reserved, `0`                                                    |
 //!
 //! For the configuration and test functions (codes `0x20`‥`0x23`) with reasons `1`, `2`,
-//! `5` and `7`, bytes 2‥5 are the bound as an IEEE-754 `f32` in SI units (for `5` the mode
-//! code the command needs) (the parameter's unit; A, rad/s or Pa for a step
-//! amplitude, s for a step duration) and byte 6 is the parameter id (`0` when no parameter
-//! is concerned); for the others byte 6 is `0`.
+//! `5` and `7`, bytes 2‥5 are the bound as an IEEE-754 `f32` in SI units instead: the
+//! parameter's unit; A, rad/s or Pa for a step amplitude; s for a step duration; for
+//! reason `5` the code of the mode the command needs ([`Rejection::si_bound`]).
 //!
 //! Reason codes: `1` value below the minimum, `2` value above the maximum, `3` wrong data
 //! length (bound = expected DLC), `4` unknown mode code (bound = highest mode code), `5`
@@ -185,6 +187,19 @@ impl Frame {
     /// The payload (DLC bytes).
     pub fn payload(&self) -> &[u8] {
         self.data.get(..usize::from(self.len)).unwrap_or(&[])
+    }
+}
+
+/// The frame in the `cansend`/`candump` notation of Linux SocketCAN: three hex digits of
+/// identifier, `#`, the payload in hex (`203#0A0000803E`), so a printed command can be
+/// sent with `cansend can0 <frame>`.
+impl core::fmt::Display for Frame {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{:03X}#", self.id)?;
+        for b in self.payload() {
+            write!(f, "{b:02X}")?;
+        }
+        Ok(())
     }
 }
 
@@ -584,6 +599,9 @@ impl Rejection {
         let (reason, bound) = match *err {
             ParamError::BelowMinimum { min, .. } => (RejectReason::BelowMinimum, min),
             ParamError::AboveMaximum { max, .. } => (RejectReason::AboveMaximum, max),
+            ParamError::NotWhileRunning { .. } => {
+                (RejectReason::NotAllowed, f32::from(Mode::Disabled.code()))
+            }
             ParamError::NotANumber { .. }
             | ParamError::NotWhole { .. }
             | ParamError::Inconsistent { .. } => (RejectReason::Invalid, 0.0),

@@ -28,7 +28,7 @@ use crate::config::{whole_ratio, Config};
 use crate::current_loop::{CurrentLoop, CurrentLoopState};
 use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
 use crate::io::{Measurements, Outputs};
-use crate::parameters::{ParamError, ParamId};
+use crate::parameters::{self, ParamError, ParamId, TableError, COUNT};
 use crate::pi::saturate;
 use crate::pressure_loop::PressureLoop;
 use crate::speed_loop::SpeedLoop;
@@ -282,6 +282,18 @@ impl Controller {
             forced_frame: false,
             step: None,
         }
+    }
+
+    /// Replaces the whole live table (boot: the stored table, in
+    /// [`ParamId::ALL`] order): every value checked against its bounds, the whole against
+    /// [`crate::parameters::cross_check`], then applied like [`Command::SetParameter`].
+    /// On a refusal nothing changes. Cheaper in flash than building the controller from a
+    /// run-time configuration: [`Controller::new`] on the constant nominal configuration
+    /// folds away at compile time.
+    pub fn load_parameters(&mut self, values: &[f32; COUNT]) -> Result<(), TableError> {
+        parameters::apply_all(&mut self.cfg, values)?;
+        self.retune(ParamId::EncoderOffset);
+        Ok(())
     }
 
     /// Value of a live parameter. [the parameter's unit]
@@ -630,6 +642,9 @@ impl Controller {
         match c {
             Command::Heartbeat => Ok(()),
             Command::SetParameter { id, value } => {
+                if id.needs_disabled() && self.sup.mode() != Mode::Disabled {
+                    return Err(CommandError::Parameter(ParamError::NotWhileRunning { id }));
+                }
                 id.set(&mut self.cfg, value)
                     .map_err(CommandError::Parameter)?;
                 self.retune(id);
@@ -749,7 +764,7 @@ impl Controller {
             duration_s,
             reference,
             (lo, hi),
-            self.d.pwm_hz as f32,
+            self.cfg.rates.pwm_hz,
         )
         .map_err(CommandError::StepTest)?;
         self.set_step_reference(target, s.stepped);

@@ -13,8 +13,8 @@
 #![cfg_attr(not(test), no_std)]
 
 pub mod can_protocol;
-pub mod commissioning;
 pub mod can_server;
+pub mod commissioning;
 pub mod config;
 pub mod controller;
 pub mod current_loop;

@@ -29,7 +29,7 @@
 //! | 4      | 2    | format version ([`FORMAT_VERSION`])                          |
 //! | 6      | 2    | number of values ([`crate::parameters::COUNT`])              |
 //! | 8      | 4    | sequence number                                              |
-//! | 12     | 4    | table fingerprint ([`crate::parameters::layout_fingerprint`]) |
+//! | 12     | 4    | table fingerprint ([`crate::parameters::LAYOUT_FINGERPRINT`]) |
 //! | 16     | 4·N  | values, `f32`, in [`crate::parameters::ParamId::ALL`] order  |
 //! | 16+4N  | 4    | CRC-32 (ISO-HDLC) of bytes 0‥16+4N                           |
 //! | …      |      | `0xFF` padding to a multiple of 8 bytes                      |
@@ -43,8 +43,8 @@
 //! [`ParamStore::load`] takes the valid record with the larger sequence number. Without
 //! one, the outcome says why: both pages blank (never saved: defaults, no fault), or a
 //! record that is corrupt or of another format version or table (defaults and fault 16,
-//! [`crate::FaultCode::ParameterStoreInvalid`]). [`boot_config`] also refuses a
-//! record whose values are out of their bounds or inconsistent, so the controller never
+//! [`crate::FaultCode::ParameterStoreInvalid`]). [`boot`] and [`boot_config`] also refuse
+//! a record whose values are out of their bounds or inconsistent, so the controller never
 //! starts from garbage.
 
 use crate::config::Config;
@@ -66,14 +66,14 @@ pub const COMMIT_MAGIC: u32 = 0x544D_4D43;
 const HEADER_LEN: usize = 16;
 const CRC_AT: usize = HEADER_LEN + 4 * COUNT;
 /// Length of the record with its padding, before the commit word. [bytes]
-pub const RECORD_LEN: usize = (CRC_AT + 4 + 7) / 8 * 8;
+pub const RECORD_LEN: usize = (CRC_AT + 4).div_ceil(8) * 8;
 /// Length of the commit word. [bytes]
 pub const COMMIT_LEN: usize = 8;
 /// Bytes a record occupies in its page. [bytes]
 pub const SPAN: usize = RECORD_LEN + COMMIT_LEN;
 
 /// What a page holds.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug)]
 enum Page {
     /// Erased header: never written (or the erase of a save was the last thing done).
     Blank,
@@ -159,8 +159,11 @@ impl<F: NorFlash> ParamStore<F> {
         let pages = self.pages.map(|p| self.read_page(p));
         match newest(&pages) {
             Some((_, sequence, values)) => (Some(values), LoadOutcome::Loaded { sequence }),
-            None if pages.iter().all(|p| *p == Page::Blank) => (None, LoadOutcome::Blank),
-            None if pages.contains(&Page::OtherVersion) => (None, LoadOutcome::OtherVersion),
+            // `matches!`, not `==`: a derived comparison of the value arrays costs flash.
+            None if pages.iter().all(|p| matches!(p, Page::Blank)) => (None, LoadOutcome::Blank),
+            None if pages.iter().any(|p| matches!(p, Page::OtherVersion)) => {
+                (None, LoadOutcome::OtherVersion)
+            }
             None => (None, LoadOutcome::Corrupt),
         }
     }
@@ -212,7 +215,7 @@ fn encode(sequence: u32, values: &[f32; COUNT]) -> [u8; RECORD_LEN] {
     // COUNT is a few dozen: fits u16.
     r[6..8].copy_from_slice(&(COUNT as u16).to_le_bytes());
     r[8..12].copy_from_slice(&sequence.to_le_bytes());
-    r[12..16].copy_from_slice(&parameters::layout_fingerprint().to_le_bytes());
+    r[12..16].copy_from_slice(&parameters::LAYOUT_FINGERPRINT.to_le_bytes());
     for (chunk, v) in r[HEADER_LEN..CRC_AT].chunks_exact_mut(4).zip(values) {
         chunk.copy_from_slice(&v.to_le_bytes());
     }
@@ -241,7 +244,7 @@ fn parse(b: &[u8; SPAN]) -> Page {
     let count = u16::from_le_bytes([b[6], b[7]]);
     if version != FORMAT_VERSION
         || usize::from(count) != COUNT
-        || u32_at(b, 12) != parameters::layout_fingerprint()
+        || u32_at(b, 12) != parameters::LAYOUT_FINGERPRINT
     {
         return Page::OtherVersion;
     }
@@ -281,29 +284,35 @@ impl BootOutcome {
     }
 }
 
+/// Boot: loads the newest table and hands it to `apply` (which checks and applies it,
+/// returning false when it refuses it). A record `apply` refuses counts as invalid.
+pub fn boot<F: NorFlash>(
+    store: &mut ParamStore<F>,
+    apply: impl FnOnce(&[f32; COUNT]) -> bool,
+) -> BootOutcome {
+    match store.load() {
+        (Some(v), LoadOutcome::Loaded { sequence }) => {
+            if apply(&v) {
+                BootOutcome::Stored { sequence }
+            } else {
+                BootOutcome::DefaultsAfterInvalid(LoadOutcome::Corrupt)
+            }
+        }
+        (_, LoadOutcome::Blank) => BootOutcome::Defaults,
+        (_, other) => BootOutcome::DefaultsAfterInvalid(other),
+    }
+}
+
 /// The configuration to boot with: `defaults` with the stored table applied, or
 /// `defaults` alone when nothing usable is stored. A record whose values fail their
-/// bounds or [`Config::validate`] counts as invalid.
+/// bounds or the cross-checks counts as invalid.
 pub fn boot_config<F: NorFlash>(
     store: &mut ParamStore<F>,
     defaults: &Config,
 ) -> (Config, BootOutcome) {
-    let (values, outcome) = store.load();
     let mut cfg = *defaults;
-    match (values, outcome) {
-        (Some(v), LoadOutcome::Loaded { sequence }) => {
-            if parameters::apply_all(&mut cfg, &v).is_ok() {
-                (cfg, BootOutcome::Stored { sequence })
-            } else {
-                (
-                    *defaults,
-                    BootOutcome::DefaultsAfterInvalid(LoadOutcome::Corrupt),
-                )
-            }
-        }
-        (_, LoadOutcome::Blank) => (cfg, BootOutcome::Defaults),
-        (_, other) => (cfg, BootOutcome::DefaultsAfterInvalid(other)),
-    }
+    let outcome = boot(store, |v| parameters::apply_all(&mut cfg, v).is_ok());
+    (cfg, outcome)
 }
 
 #[cfg(test)]

@@ -5,16 +5,20 @@
 //!
 //! A parameter is read from and written into a [`Config`]; [`ParamId::set`] checks the
 //! value against the parameter's bounds first (so a refusal names the bound), then the
-//! whole configuration with [`Config::validate`] (so cross-field rules such as "the
-//! feedback filter must be at least twice the pressure bandwidth" still hold, and a
-//! refusal names the conflicting field). Defaults are those of [`Config::nominal`].
+//! rules of [`Config::validate`] that tie a parameter to other fields ([`cross_check`]:
+//! "the feedback filter must be at least twice the pressure bandwidth", "the over-current
+//! trip must exceed the q-current limit", …; a refusal names the conflicting field). The
+//! bounds contain every single-field rule of the validator, so bounds plus cross-check
+//! accept exactly what the validator accepts (a test holds them to that) for a fraction
+//! of its code: the firmware links no general validator, the nominal configuration's
+//! check folds away at compile time. Defaults are those of [`Config::nominal`].
 //! How a changed value reaches the running loops is the controller's business
 //! ([`crate::Controller`] applies it between control steps, bumplessly).
 //!
 //! Ids are grouped by tens (current loop 1–5, speed loop 10–15, pressure loop 20–25,
 //! hydraulics 30–36, telemetry 40, commissioning results 50–54); an id is never reused for
 //! another meaning. The stored table ([`crate::param_store`]) carries a fingerprint of this
-//! list ([`layout_fingerprint`]), so a firmware with a changed table never loads an old
+//! list ([`LAYOUT_FINGERPRINT`]), so a firmware with a changed table never loads an old
 //! record as if it matched.
 //!
 //! # Parameter table
@@ -57,7 +61,7 @@
 //!
 //! The table above is checked against the code by this module's tests.
 
-use crate::config::Config;
+use crate::config::{Config, ConfigError};
 use core::fmt;
 
 /// Number of parameters in the table.
@@ -181,7 +185,7 @@ impl ParamId {
         ParamId::EncoderOffset,
     ];
 
-    fn spec(self) -> Spec {
+    const fn spec(self) -> Spec {
         use ParamId::*;
         match self {
             CurrentKpD => spec("current.kp_d", "V/A", 0.01, 200.0),
@@ -260,6 +264,12 @@ impl ParamId {
     /// Largest accepted value. [unit]
     pub fn max(self) -> f32 {
         self.spec().max
+    }
+
+    /// True for a parameter that may change only while the bridge is off: a new encoder
+    /// offset turns the field orientation at once, a torque step no ramp can soften.
+    pub fn needs_disabled(self) -> bool {
+        self == ParamId::EncoderOffset
     }
 
     /// True for a parameter that takes whole numbers only.
@@ -381,7 +391,7 @@ impl ParamId {
         self.check(value)?;
         let mut next = *cfg;
         self.write(&mut next, value);
-        next.validate().map_err(|e| ParamError::Inconsistent {
+        cross_check(&next).map_err(|e| ParamError::Inconsistent {
             id: self,
             field: e.field,
             problem: e.problem,
@@ -424,6 +434,11 @@ pub enum ParamError {
         /// The parameter.
         id: ParamId,
     },
+    /// Changeable only in Disabled ([`ParamId::needs_disabled`]).
+    NotWhileRunning {
+        /// The parameter.
+        id: ParamId,
+    },
     /// Within its bounds, but the configuration with it fails validation.
     Inconsistent {
         /// The parameter.
@@ -443,6 +458,7 @@ impl ParamError {
             | ParamError::AboveMaximum { id, .. }
             | ParamError::NotANumber { id }
             | ParamError::NotWhole { id }
+            | ParamError::NotWhileRunning { id }
             | ParamError::Inconsistent { id, .. } => id,
         }
     }
@@ -459,11 +475,21 @@ impl fmt::Display for ParamError {
             }
             ParamError::NotANumber { id } => write!(f, "{id}: not a number"),
             ParamError::NotWhole { id } => write!(f, "{id}: must be a whole number"),
+            ParamError::NotWhileRunning { id } => write!(f, "{id}: only in Disabled"),
             ParamError::Inconsistent { id, field, problem } => {
                 write!(f, "{id}: refused, config field `{field}` {problem}")
             }
         }
     }
+}
+
+/// Why a whole stored table was refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TableError {
+    /// A value outside its own bounds.
+    Value(ParamError),
+    /// Every value within its bounds, but the configuration fails validation.
+    Inconsistent(ConfigError),
 }
 
 /// All parameter values of `cfg`, in [`ParamId::ALL`] order.
@@ -475,32 +501,92 @@ pub fn snapshot(cfg: &Config) -> [f32; COUNT] {
 /// each against its bounds and the result with [`Config::validate`]; on any refusal `cfg`
 /// is left as it was. Used at boot for a stored table, whose values may be individually
 /// valid and only consistent together.
-pub fn apply_all(cfg: &mut Config, values: &[f32; COUNT]) -> Result<(), ParamError> {
+pub fn apply_all(cfg: &mut Config, values: &[f32; COUNT]) -> Result<(), TableError> {
     let mut next = *cfg;
     for (p, v) in ParamId::ALL.iter().zip(values) {
-        p.check(*v)?;
+        p.check(*v).map_err(TableError::Value)?;
         p.write(&mut next, *v);
     }
-    next.validate().map_err(|e| ParamError::Inconsistent {
-        // The first parameter whose field the validator named, else the first one.
-        id: ParamId::from_name(e.field).unwrap_or(ParamId::CurrentKpD),
-        field: e.field,
-        problem: e.problem,
-    })?;
+    cross_check(&next).map_err(TableError::Inconsistent)?;
     *cfg = next;
+    Ok(())
+}
+
+/// The rules of [`Config::validate`] that relate a table parameter to another field, on
+/// a configuration that was valid before its table parameters were changed within their
+/// bounds. Same field names and messages as the validator.
+pub fn cross_check(cfg: &Config) -> Result<(), ConfigError> {
+    let err = |field, problem| Err(ConfigError { field, problem });
+    let (r, sp, p, l) = (&cfg.rates, &cfg.speed, &cfg.pressure, &cfg.limits);
+    if r.pressure_loop_hz < 10.0 * p.bandwidth_rad_s / core::f32::consts::TAU {
+        return err(
+            "rates.pressure_loop_hz",
+            "must be at least 10x the pressure-loop bandwidth",
+        );
+    }
+    if sp.observer_bandwidth_rad_s > 0.25 * r.pwm_hz {
+        return err(
+            "speed.observer_bandwidth_rad_s",
+            "must be at most 0.25 * rates.pwm_hz (omega_n * T <= 0.25)",
+        );
+    }
+    if p.feedback_filter_rad_s < 2.0 * p.bandwidth_rad_s {
+        return err(
+            "pressure.feedback_filter_rad_s",
+            "must be at least 2x pressure.bandwidth_rad_s",
+        );
+    }
+    if p.setpoint_min_pa >= p.setpoint_max_pa {
+        return err(
+            "pressure.setpoint_min_pa",
+            "must be below pressure.setpoint_max_pa",
+        );
+    }
+    if l.over_current_a <= sp.iq_limit_a {
+        return err("limits.over_current_a", "must exceed speed.iq_limit_a");
+    }
+    if l.over_pressure_pa <= p.setpoint_max_pa {
+        return err(
+            "limits.over_pressure_pa",
+            "must exceed pressure.setpoint_max_pa",
+        );
+    }
+    if l.over_speed_rad_s <= sp.speed_limit_rad_s {
+        return err(
+            "limits.over_speed_rad_s",
+            "must exceed speed.speed_limit_rad_s",
+        );
+    }
+    let k = &cfg.commissioning;
+    if k.pulse_voltage_v > 0.5 * cfg.current.voltage_limit_v {
+        return err(
+            "commissioning.pulse_voltage_v",
+            "must be > 0 and at most 0.5 * current.voltage_limit_v",
+        );
+    }
+    if k.spin_speed_rad_s > sp.speed_limit_rad_s {
+        return err(
+            "commissioning.spin_speed_rad_s",
+            "must be > 0 and at most speed.speed_limit_rad_s",
+        );
+    }
     Ok(())
 }
 
 /// CRC-32 of the table's ids and names in order: changes whenever a parameter is added,
 /// removed, renumbered or renamed, so a stored record of another table is recognised.
-pub fn layout_fingerprint() -> u32 {
+/// Computed at compile time (no names walked at run time).
+pub const LAYOUT_FINGERPRINT: u32 = {
     let mut digest = crate::param_store::CRC.digest();
-    for p in ParamId::ALL {
-        digest.update(&[p.code()]);
-        digest.update(p.name().as_bytes());
+    let mut i = 0;
+    while i < COUNT {
+        let p = ParamId::ALL[i];
+        digest.update(&[p as u8]);
+        digest.update(p.spec().name.as_bytes());
+        i += 1;
     }
     digest.finalize()
-}
+};
 
 #[cfg(test)]
 mod tests;

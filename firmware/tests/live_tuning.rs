@@ -199,3 +199,24 @@ fn parameters_reach_the_running_drive() {
     .unwrap();
     assert_eq!(c.telemetry_decimation(), 5);
 }
+
+#[test]
+fn the_encoder_offset_changes_only_with_the_bridge_off() {
+    let mut c = running(Mode::Speed);
+    let set = Command::SetParameter {
+        id: ParamId::EncoderOffset,
+        value: 1.0,
+    };
+    assert_eq!(
+        c.command(set),
+        Err(CommandError::Parameter(
+            firmware::parameters::ParamError::NotWhileRunning {
+                id: ParamId::EncoderOffset
+            }
+        ))
+    );
+    c.command(Command::SetMode(Mode::Disabled)).unwrap();
+    c.command(set).unwrap();
+    assert_eq!(c.encoder_offset(), 1.0);
+    assert_eq!(c.parameter(ParamId::EncoderOffset), 1.0);
+}

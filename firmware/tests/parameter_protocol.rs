@@ -10,7 +10,7 @@ use firmware::can_protocol::{
     encode_set_parameter, Frame, NodeId, RejectReason, Rejection, Reply, Request,
 };
 use firmware::can_server::{serve, Response};
-use firmware::param_store::{boot_config, BootOutcome, ParamStore};
+use firmware::param_store::{boot, boot_config, BootOutcome, ParamStore};
 use firmware::parameters::{ParamId, COUNT};
 use firmware::{Command, Config, Controller, Mode};
 
@@ -156,6 +156,16 @@ fn the_set_parameter_frame_is_the_documented_layout() {
     );
     assert_eq!(r.id(), 0x1A3);
     assert_eq!(r.payload(), &[10, 0x00, 0x00, 0x80, 0x3E, 0, 0, 0]);
+    // Printed for `cansend can0 …`.
+    assert_eq!(f_text(ParamId::SpeedKp, 0.25), "203#0A0000803E");
+    assert_eq!(
+        encode_command(&Request::SaveParameters, node()).to_string(),
+        "223#"
+    );
+}
+
+fn f_text(id: ParamId, value: f32) -> String {
+    encode_set_parameter(id, value, node()).to_string()
 }
 
 /// A RAM NOR flash for the save path (the power-cut tests are in `param_store`).
@@ -218,10 +228,12 @@ fn a_table_set_over_can_and_saved_is_there_after_a_reboot() {
     assert_eq!(values.len(), COUNT);
     store.save(&values).expect("saved");
 
-    // Reboot: a new controller from the stored table.
-    let (cfg, outcome) = boot_config(&mut store, &Config::nominal());
+    // Reboot as the application does: the nominal controller, then the stored table.
+    let mut rebooted = Controller::new(&Config::nominal());
+    let outcome = boot(&mut store, |v| rebooted.load_parameters(v).is_ok());
     assert_eq!(outcome, BootOutcome::Stored { sequence: 1 });
-    let mut rebooted = Controller::new(&cfg);
+    let (cfg, _) = boot_config(&mut store, &Config::nominal());
+    assert_eq!(*rebooted.config(), cfg);
     for (p, v) in [
         (ParamId::SpeedKp, 0.2),
         (ParamId::AbsorberPrechargePa, 2.5e6),

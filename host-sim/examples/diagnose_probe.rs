@@ -7,7 +7,11 @@ use plant_model::Rig;
 use std::path::PathBuf;
 
 fn main() {
-    let path = PathBuf::from(std::env::args().nth(1).expect("usage: diagnose_probe LOG.csv"));
+    let path = PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .expect("usage: diagnose_probe LOG.csv"),
+    );
     let log = host_sim::bench_log::read(&path).expect("a valid bench log");
     let rig = Rig::nominal();
     let cl = replay_closed_loop(&log, &rig).expect("a log with setpoints");

@@ -223,3 +223,44 @@ fn two_current_levels_cancel_the_dead_time_voltage_error() {
         assert!(e.abs() < 5.0, "{name} off by {e:.2} % with dead time");
     }
 }
+
+#[test]
+fn the_results_land_in_the_live_parameter_table_and_survive_a_parameter_change() {
+    use closed_loop::commissioning::COMMISSIONING;
+    use closed_loop::ClosedLoop;
+    use firmware::parameters::ParamId;
+    use firmware::{Command, Mode};
+
+    let mut rig = perturbed(3);
+    rig.sensors.encoder.offset_rad = 2.0;
+    let mut cl = ClosedLoop::new(&rig, &nameplate_config(&rig), &COMMISSIONING, 3).expect("rig");
+    cl.command(Command::Commission).expect("commission");
+    while cl.time_s() < 10.0 {
+        cl.step();
+        if cl.controller_mut().mode() == Mode::Disabled {
+            break;
+        }
+    }
+    let c = cl.controller_mut();
+    let r = c.commissioning_result().expect("a result");
+    // The table reads what commissioning found, the values a save would store.
+    for (p, want) in [
+        (ParamId::StatorResistance, r.stator_resistance_ohm),
+        (ParamId::DInductance, r.d_inductance_h),
+        (ParamId::QInductance, r.q_inductance_h),
+        (ParamId::FluxLinkage, r.flux_linkage_wb),
+        (ParamId::CurrentKpD, r.current_gains.kp_d),
+        (ParamId::CurrentKpQ, r.current_gains.kp_q),
+        (ParamId::CurrentKiQ, r.current_gains.ki),
+    ] {
+        assert_eq!(c.parameter(p), want, "{p}");
+    }
+    assert_eq!(c.parameter(ParamId::EncoderOffset), c.encoder_offset());
+    // A later change of another parameter retunes from the table: the gains stay.
+    c.command(Command::SetParameter {
+        id: ParamId::SpeedKp,
+        value: 0.2,
+    })
+    .expect("set");
+    assert_eq!(c.parameter(ParamId::CurrentKpQ), r.current_gains.kp_q);
+}

@@ -22,6 +22,7 @@
 //! | status LED LD2                   | GPIO                       | PA5 (D13)            | —            |
 //! | embassy time driver              | TIM15                      | —                    | —            |
 //! | watchdog                         | IWDG (LSI)                 | —                    | —            |
+//! | parameter store                  | FLASH, last two 4 KiB pages (0x0807_E000‥0x0807_FFFF) | — | — |
 //!
 //! Clocks: 24 MHz HSE crystal (X3 on the Nucleo) → PLL (÷6, ×85, R ÷2) → 170 MHz SYSCLK,
 //! boost mode; TIM1 and TIM2 at 170 MHz; ADC1/2 on SYSCLK (÷4 by the driver: 42.5 MHz);
@@ -36,6 +37,7 @@
 
 use embassy_stm32::adc::{Adc, AdcChannel as _, AdcConfig, Exten, InjectedAdc, SampleTime};
 use embassy_stm32::can::{self, CanConfigurator};
+use embassy_stm32::flash::{Blocking, Flash};
 use embassy_stm32::gpio::OutputType::PushPull;
 use embassy_stm32::gpio::{AfType, Flex, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
@@ -128,6 +130,8 @@ pub struct Board {
     pub watchdog: IndependentWatchdog<'static, IWDG>,
     /// For the supervision task.
     pub led: Output<'static>,
+    /// For the parameter store (the last two pages, see [`super::param_flash`]).
+    pub flash: Flash<'static, Blocking>,
 }
 
 /// Brings up clocks and peripherals. The bridge comes up disabled (MOE = 0, all six
@@ -269,6 +273,7 @@ pub fn init(pwm_hz: u32, encoder_counts_per_rev: u32) -> Board {
         can,
         watchdog: IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_US),
         led: Output::new(p.PA5, Level::Low, Speed::Low),
+        flash: Flash::new_blocking(p.FLASH),
     }
 }
 

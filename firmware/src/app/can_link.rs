@@ -1,9 +1,12 @@
 //! The CAN tasks: commands in, status and rejections out, over FDCAN1 in classic mode with
 //! the frame layout of [`firmware::can_protocol`].
 //!
-//! The receive task decodes each frame addressed to this node, hands the command to the
-//! controller and queues the reply (a status for an accepted command other than a
-//! heartbeat, a reject naming the bound for a refused or malformed one). The transmit task
+//! The receive task decodes each frame addressed to this node, serves it with
+//! [`firmware::can_server::serve`] (the same code the host tests run) and queues the reply
+//! (a status for an accepted command other than a heartbeat or a parameter command, a
+//! `Parameter` frame for a parameter get or set, a reject naming the bound for a refused
+//! or malformed one). `SaveParameters` writes the flash from this task
+//! ([`super::param_flash::save`]), outside the controller's critical section. The transmit task
 //! sends queued replies and, when none is due, a status every [`STATUS_PERIOD`]. The
 //! command timeout itself is the controller's: heartbeats are forwarded to it like any
 //! other command.
@@ -14,11 +17,14 @@ use embassy_sync::channel::Channel;
 use embassy_time::{with_timeout, Duration};
 use embedded_can::Id;
 use firmware::can_protocol::{
-    decode_command, encode_reply, Frame, NodeId, Rejection, Reply, Request, Status, NO_COMMAND,
+    decode_command, encode_reply, Frame, Function, NodeId, Rejection, Reply, Request, Status,
+    NO_COMMAND,
 };
+use firmware::can_server::{save_failed, serve, Response};
 use firmware::Mode;
 
 use super::control;
+use super::param_flash::{self, Store};
 
 /// Period of the unsolicited status frame.
 pub const STATUS_PERIOD: Duration = Duration::from_millis(100);
@@ -28,8 +34,8 @@ pub const STATUS_PERIOD: Duration = Duration::from_millis(100);
 enum Outgoing {
     /// A status acknowledging a command of this function code.
     Ack(u8),
-    /// A rejection.
-    Reject(Rejection),
+    /// A reply frame (parameter value or rejection).
+    Reply(Reply),
 }
 
 static OUTGOING: Channel<CriticalSectionRawMutex, Outgoing, 4> = Channel::new();
@@ -42,7 +48,7 @@ pub fn split(can: Can<'static>) -> (CanTx<'static>, CanRx<'static>) {
 
 /// Receives and executes commands.
 #[embassy_executor::task]
-pub async fn receive(mut rx: CanRx<'static>, node: NodeId) {
+pub async fn receive(mut rx: CanRx<'static>, node: NodeId, mut store: Store) {
     loop {
         let envelope = match rx.read().await {
             Ok(e) => e,
@@ -55,8 +61,10 @@ pub async fn receive(mut rx: CanRx<'static>, node: NodeId) {
             continue;
         };
         let outgoing = match decode_command(&frame, node) {
-            Ok(request) => execute(&request),
-            Err(err) => Rejection::for_decode_error(&err).map(Outgoing::Reject),
+            Ok(request) => execute(&request, &mut store),
+            Err(err) => {
+                Rejection::for_decode_error(&err).map(|r| Outgoing::Reply(Reply::Reject(r)))
+            }
         };
         if let Some(o) = outgoing {
             // A full queue means the bus is saturated; the periodic status still reports.
@@ -72,7 +80,7 @@ pub async fn transmit(mut tx: CanTx<'static>, node: NodeId) {
     let mut last_command = NO_COMMAND;
     loop {
         let reply = match with_timeout(STATUS_PERIOD, OUTGOING.receive()).await {
-            Ok(Outgoing::Reject(r)) => Reply::Reject(r),
+            Ok(Outgoing::Reply(r)) => r,
             Ok(Outgoing::Ack(function)) => {
                 last_command = function;
                 status(last_command, sequence)
@@ -91,13 +99,22 @@ pub async fn transmit(mut tx: CanTx<'static>, node: NodeId) {
     }
 }
 
-fn execute(request: &Request) -> Option<Outgoing> {
-    let command = request.to_command()?;
-    let result = control::with_controller(|c| c.command(command))?;
-    match result {
-        Ok(()) if *request == Request::Heartbeat => None,
-        Ok(()) => Some(Outgoing::Ack(request.function().code())),
-        Err(e) => Some(Outgoing::Reject(Rejection::for_command_error(request, &e))),
+fn execute(request: &Request, store: &mut Store) -> Option<Outgoing> {
+    match control::with_controller(|c| serve(request, c))? {
+        Response::Silent => None,
+        Response::Ack(function) => Some(Outgoing::Ack(function)),
+        Response::Reply(reply) => Some(Outgoing::Reply(reply)),
+        // `serve` checked that the bridge is off; the flash write stalls the CPU ~25 ms.
+        Response::Save(values) => match param_flash::save(store, &values) {
+            Ok(sequence) => {
+                defmt::info!("parameters: table {} saved", sequence);
+                Some(Outgoing::Ack(Function::SaveParameters.code()))
+            }
+            Err(_) => {
+                defmt::error!("parameters: flash write failed");
+                Some(Outgoing::Reply(save_failed()))
+            }
+        },
     }
 }
 

@@ -5,18 +5,22 @@
 //!   another board), and the interrupt vector of the current loop.
 //! - [`control`]: the current-loop interrupt (highest priority, not a task) and the state
 //!   it shares with the tasks; [`bridge`] and [`sensors`] are its drivers.
+//! - [`param_flash`]: the parameter table in the last two flash pages.
 //! - Tasks on the thread-mode executor: [`can_link`] (commands and replies over FDCAN1),
 //!   [`telemetry`] (defmt over RTT), [`supervision`] (independent watchdog, LED, load).
 //!
 //! Start-up: configuration validated (on error the bridge stays off and the error is
-//! logged), peripherals brought up with the bridge disabled, the drive installed, the
-//! interrupt enabled, the tasks spawned. The drive starts in Disabled; a CAN `SetMode`
+//! logged), peripherals brought up with the bridge disabled, the stored parameter table
+//! applied over the defaults ([`firmware::param_store::boot`]: a corrupt,
+//! other-version or inconsistent record gives the defaults and latches fault 16), the
+//! drive installed, the interrupt enabled, the tasks spawned. The drive starts in Disabled; a CAN `SetMode`
 //! command starts it.
 
 mod board;
 mod bridge;
 mod can_link;
 mod control;
+mod param_flash;
 mod sensors;
 mod supervision;
 mod telemetry;
@@ -25,6 +29,7 @@ use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_time::Timer;
 use firmware::can_protocol::NodeId;
+use firmware::param_store::{boot, BootOutcome};
 use firmware::{Config, Controller};
 use panic_probe as _;
 
@@ -58,22 +63,39 @@ async fn main(spawner: Spawner) {
 
     enable_cycle_counter();
     let b = board::init(pwm_hz, config.sensors.encoder_counts_per_rev);
-    control::install(
-        Controller::new(&config),
-        Bridge::new(b.power),
-        Sensors::new(b.sensors),
-    );
+    // The live table covers gains, limits and commissioning results, never the rates or
+    // the encoder resolution the board was just set up with.
+    let mut store = match param_flash::open(b.flash) {
+        Ok(s) => s,
+        Err(_) => defmt::panic!("parameter pages do not fit the flash layout"),
+    };
+    // Built from the constant nominal configuration, then given the stored table: the
+    // constructor folds at compile time, the table goes through the live-parameter path.
+    let mut controller = Controller::new(&config);
+    let outcome = boot(&mut store, |v| controller.load_parameters(v).is_ok());
+    match outcome {
+        BootOutcome::Stored { sequence } => {
+            defmt::info!("parameters: stored table {} loaded", sequence)
+        }
+        BootOutcome::Defaults => defmt::info!("parameters: none stored, defaults"),
+        BootOutcome::DefaultsAfterInvalid(_) => {
+            defmt::error!("parameters: stored table unusable, defaults loaded (fault 16)");
+            controller.report_parameter_store_invalid();
+        }
+    }
+    let decimation = controller.telemetry_decimation();
+    control::install(controller, Bridge::new(b.power), Sensors::new(b.sensors));
     board::enable_current_loop_interrupt();
     defmt::info!(
         "EHA drive up: PWM {} Hz, CAN node {} at {} bit/s, telemetry every {} periods",
         pwm_hz,
         node.get(),
         board::CAN_BITRATE,
-        telemetry::TELEMETRY_DECIMATION
+        decimation
     );
 
     let (tx, rx) = can_link::split(b.can.into_normal_mode());
-    spawner.spawn(unwrap_spawn(can_link::receive(rx, node)));
+    spawner.spawn(unwrap_spawn(can_link::receive(rx, node, store)));
     spawner.spawn(unwrap_spawn(can_link::transmit(tx, node)));
     spawner.spawn(unwrap_spawn(telemetry::run(pwm_hz)));
     spawner.spawn(unwrap_spawn(supervision::run(b.watchdog, b.led, pwm_hz)));

@@ -43,6 +43,12 @@ impl Controller {
             let (l_d, l_q, _) = self.commissioning.machine();
             self.current
                 .set_machine(l_d, l_q, self.cfg.motor.flux_linkage_wb);
+            // The live parameter table holds what the loops use, so a later parameter
+            // change (which retunes from the table) keeps the commissioned gains, and a
+            // save stores them.
+            let c = &mut self.cfg.current;
+            (c.kp_d, c.kp_q, c.ki_d, c.ki_q) = (g.kp_d, g.kp_q, g.ki, g.ki);
+            (self.cfg.motor.d_inductance_h, self.cfg.motor.q_inductance_h) = (l_d, l_q);
         }
         match action {
             Action::Off => (false, 0.0, None),
@@ -73,6 +79,13 @@ impl Controller {
                     self.current
                         .set_machine(r.d_inductance_h, r.q_inductance_h, r.flux_linkage_wb);
                     self.calibrated = true;
+                    // The commissioning results in the live table (see above).
+                    let m = &mut self.cfg.motor;
+                    m.stator_resistance_ohm = r.stator_resistance_ohm;
+                    m.d_inductance_h = r.d_inductance_h;
+                    m.q_inductance_h = r.q_inductance_h;
+                    m.flux_linkage_wb = r.flux_linkage_wb;
+                    self.cfg.sensors.encoder_offset_rad = self.encoder.offset();
                 }
                 self.finish_commissioning();
                 // Disabled is always granted.

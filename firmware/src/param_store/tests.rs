@@ -199,6 +199,11 @@ fn cut_everywhere(before: &[[f32; COUNT]]) -> usize {
         rebooted.save(&again).unwrap();
         assert_eq!(rebooted.load().0, Some(again), "save after cut {cut}");
     }
+    println!(
+        "{} saves before: {} cut points (erase {PAGE} B, record {RECORD_LEN} B, commit {COMMIT_LEN} B), each reloads the previous table",
+        before.len(),
+        total + 1
+    );
     total + 1
 }
 
@@ -275,7 +280,7 @@ fn the_crc_is_crc32_iso_hdlc() {
 #[test]
 fn a_record_written_to_the_documented_layout_loads() {
     let t = table(3.0);
-    let rec = documented_record(1, parameters::layout_fingerprint(), 7, &t);
+    let rec = documented_record(1, parameters::LAYOUT_FINGERPRINT, 7, &t);
     assert_eq!(rec.len(), SPAN);
     let mut s = store(flash_with(&rec));
     assert_eq!(s.load(), (Some(t), LoadOutcome::Loaded { sequence: 7 }));
@@ -283,7 +288,7 @@ fn a_record_written_to_the_documented_layout_loads() {
     let mut w = store(CutFlash::blank(2));
     w.save(&t).unwrap();
     let mem = w.into_inner().mem;
-    let rec1 = documented_record(1, parameters::layout_fingerprint(), 1, &t);
+    let rec1 = documented_record(1, parameters::LAYOUT_FINGERPRINT, 1, &t);
     assert_eq!(&mem[..SPAN], &rec1[..]);
 }
 
@@ -298,7 +303,7 @@ fn boots_to_defaults_with_fault(flash: CutFlash, want: LoadOutcome) {
 #[test]
 fn a_corrupt_record_gives_the_defaults_and_the_fault() {
     let t = table(3.0);
-    let fp = parameters::layout_fingerprint();
+    let fp = parameters::LAYOUT_FINGERPRINT;
     // One flipped bit in a value: the CRC no longer matches.
     let mut rec = documented_record(1, fp, 1, &t);
     rec[20] ^= 0x01;
@@ -315,7 +320,7 @@ fn a_corrupt_record_gives_the_defaults_and_the_fault() {
 #[test]
 fn an_old_version_or_another_table_gives_the_defaults_and_the_fault() {
     let t = table(3.0);
-    let fp = parameters::layout_fingerprint();
+    let fp = parameters::LAYOUT_FINGERPRINT;
     let rec = documented_record(0, fp, 1, &t);
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::OtherVersion);
     let rec = documented_record(1, fp ^ 1, 1, &t);
@@ -327,7 +332,7 @@ fn an_old_version_or_another_table_gives_the_defaults_and_the_fault() {
 
 #[test]
 fn stored_values_out_of_bounds_or_inconsistent_give_the_defaults_and_the_fault() {
-    let fp = parameters::layout_fingerprint();
+    let fp = parameters::LAYOUT_FINGERPRINT;
     let mut t = table(3.0);
     t[0] = 1e6; // current.kp_d above 200 V/A, CRC valid
     let rec = documented_record(1, fp, 1, &t);

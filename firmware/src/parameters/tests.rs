@@ -3,6 +3,7 @@
 //! with the bound it violates.
 
 use super::*;
+use crate::config::ConfigError;
 
 /// A number as written in the module's table: plain decimal, or `e` notation below 1e-7
 /// (where plain decimals become unreadable).
@@ -175,10 +176,86 @@ fn a_snapshot_applies_back_and_a_bad_one_changes_nothing() {
     let mut untouched = Config::nominal();
     assert_eq!(
         apply_all(&mut untouched, &bad),
-        Err(ParamError::AboveMaximum {
+        Err(TableError::Value(ParamError::AboveMaximum {
             id: ParamId::CurrentKpD,
             max: 200.0
-        })
+        }))
     );
     assert_eq!(untouched, Config::nominal());
+    // Each value within its bounds, together inconsistent: filter below 2× bandwidth.
+    let mut clash = values;
+    clash[11] = 100.0; // pressure.bandwidth_rad_s with the 150 rad/s filter
+    assert_eq!(ParamId::ALL[11], ParamId::PressureBandwidth);
+    assert!(matches!(
+        apply_all(&mut untouched, &clash),
+        Err(TableError::Inconsistent(ConfigError {
+            field: "pressure.feedback_filter_rad_s",
+            ..
+        }))
+    ));
+    assert_eq!(untouched, Config::nominal());
+}
+
+/// xorshift64: a fixed pseudo-random sequence for the equivalence test.
+fn next(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
+fn unit(state: &mut u64) -> f32 {
+    (next(state) >> 40) as f32 / (1u64 << 24) as f32
+}
+
+/// A value within the parameter's bounds: the default, a bound, uniform, or log-uniform
+/// (so small and large magnitudes are both visited).
+fn in_bounds(p: ParamId, state: &mut u64) -> f32 {
+    let (lo, hi) = (p.min(), p.max());
+    let v = match next(state) % 6 {
+        0 | 1 => p.default_value(),
+        2 => lo,
+        3 => hi,
+        4 => lo + (hi - lo) * unit(state),
+        _ => {
+            let a = libm::logf(lo.max(hi * 1e-12));
+            libm::expf(a + (libm::logf(hi) - a) * unit(state))
+        }
+    };
+    let v = v.clamp(lo, hi);
+    if p.is_integer() {
+        libm::roundf(v)
+    } else {
+        v
+    }
+}
+
+#[test]
+fn bounds_and_cross_check_accept_exactly_what_the_validator_accepts() {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let (mut accepted, mut refused) = (0, 0);
+    for _ in 0..200_000 {
+        let mut cfg = Config::nominal();
+        for p in ParamId::ALL {
+            // Change a few parameters per draw, so single rules decide often.
+            if next(&mut state) % 4 == 0 {
+                let v = in_bounds(p, &mut state);
+                assert_eq!(p.check(v), Ok(()), "{p} = {v}");
+                p.write(&mut cfg, v);
+            }
+        }
+        let full = cfg.validate();
+        let cross = cross_check(&cfg);
+        assert_eq!(full.is_ok(), cross.is_ok(), "{full:?} vs {cross:?}");
+        if full.is_ok() {
+            accepted += 1;
+        } else {
+            refused += 1;
+        }
+    }
+    // Both outcomes visited often: the comparison is not vacuous.
+    assert!(
+        accepted > 10_000 && refused > 10_000,
+        "{accepted} / {refused}"
+    );
 }

@@ -153,7 +153,9 @@ impl Candidate {
             "pressure_sensor_lag" => Effect::PressureSensorLag {
                 time_constant_s: 5e-3 * g(0).exp(),
             },
-            "current_sensor_offset" => Effect::CurrentSensorOffset { offset_a: 0.5 * g(0) },
+            "current_sensor_offset" => Effect::CurrentSensorOffset {
+                offset_a: 0.5 * g(0),
+            },
             _ => Effect::None,
         }
     }

@@ -56,7 +56,11 @@ pub fn scenario_of(log: &BenchLog) -> Option<Scenario> {
             Command::SetSpeed { rad_s: v as f32 }
         }
     };
-    let mode = if pressure { Mode::Pressure } else { Mode::Speed };
+    let mode = if pressure {
+        Mode::Pressure
+    } else {
+        Mode::Speed
+    };
     let mut events: [Option<(f64, Command)>; MAX_EVENTS] = [None; MAX_EVENTS];
     events[0] = Some((0.0, command(setpoints[0])));
     events[1] = Some((0.0, Command::SetMode(mode)));

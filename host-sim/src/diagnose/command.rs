@@ -35,7 +35,10 @@ pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
             params.join(" ")
         ));
     }
-    text.push_str(&format!("cause: {} — {}\n", d.causes[0].effect, d.causes[0].evidence));
+    text.push_str(&format!(
+        "cause: {} — {}\n",
+        d.causes[0].effect, d.causes[0].evidence
+    ));
     text.push_str("validation fit [%]   baseline  extended\n");
     for (signal, b) in &d.baseline.fit_percent_by_signal {
         let e = d.extended.fit_percent_by_signal.get(signal).copied();

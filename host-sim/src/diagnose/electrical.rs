@@ -32,10 +32,9 @@ pub fn replay_electrical(log: &BenchLog, rig: &Rig, rows: usize) -> Option<Elect
     let n = rows.min(log.len());
     let m = &rig.motor;
     let pp = m.pole_pairs as f64;
-    let u_dc = log
-        .udc_v
-        .as_deref()
-        .map_or(rig.inverter.u_dc_v, |u| u.iter().sum::<f64>() / u.len() as f64);
+    let u_dc = log.udc_v.as_deref().map_or(rig.inverter.u_dc_v, |u| {
+        u.iter().sum::<f64>() / u.len() as f64
+    });
     let loss_v = 2.0 * rig.inverter.dead_time_s * rig.inverter.pwm_frequency_hz * u_dc;
     let band = rig.inverter.dead_time_current_band_a.max(1e-9);
     let t = &log.t_s;

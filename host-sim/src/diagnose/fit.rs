@@ -65,7 +65,9 @@ impl Target<'_> {
         predicted
             .iter()
             .filter_map(|(name, y_hat)| {
-                let y = self.log.column(crate::bench_log::Signal::from_name(name)?)?;
+                let y = self
+                    .log
+                    .column(crate::bench_log::Signal::from_name(name)?)?;
                 let end = self.rows.min(y_hat.len()).min(y.len());
                 let noise = noise_variance(&y[self.from..end]);
                 let e: f64 = (self.from..end).map(|k| (y[k] - y_hat[k]).powi(2)).sum();

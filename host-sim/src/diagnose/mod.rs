@@ -32,7 +32,6 @@ pub use replay::{
     replay_hydraulics, replay_motor, replay_with, Replay, ReplayError, ReplayKind, ReplayOptions,
 };
 
-
 /// Why a log could not be diagnosed.
 #[derive(Debug, thiserror::Error)]
 pub enum DiagnoseError {

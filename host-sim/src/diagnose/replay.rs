@@ -294,7 +294,11 @@ fn simulate(
     // same observer, fed with the simulated shaft angle on a 1024 times finer grid: its
     // dynamics without the encoder's quantisation noise, which the prediction should not
     // add a second, independent time to the log's own.
-    let cpr = rig.sensors.encoder.counts_per_rev.saturating_mul(OBSERVER_SUBCOUNTS);
+    let cpr = rig
+        .sensors
+        .encoder
+        .counts_per_rev
+        .saturating_mul(OBSERVER_SUBCOUNTS);
     let counts_per_rad = cpr as f64 / (2.0 * PI);
     let observer_bandwidth = closed_loop::controller_config(&rig)
         .speed

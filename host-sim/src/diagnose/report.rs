@@ -84,7 +84,10 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
         "\nPressure RMSE: {:.0} Pa → {:.0} Pa ({:+.1} % reduction).\n",
         d.baseline.rmse_pa, d.extended.rmse_pa, d.gain.rmse_reduction_percent
     );
-    let _ = writeln!(md, "## Ranking\n\n| rank | effect | score | parameters | evidence |\n|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "## Ranking\n\n| rank | effect | score | parameters | evidence |\n|---|---|---|---|---|"
+    );
     for (k, c) in d.causes.iter().enumerate() {
         let params: Vec<String> = c
             .parameters
