@@ -78,6 +78,9 @@ impl Target<'_> {
 
     /// Normalised cost of `c` at `u`.
     pub fn cost(&self, c: &Candidate, u: &[f64]) -> f64 {
+        if !c.is_plausible(u, self.rig) {
+            return f64::MAX;
+        }
         let rig = c.rig_at(u, self.rig);
         let Ok(p) = predict(
             self.log,
