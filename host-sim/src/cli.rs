@@ -100,12 +100,25 @@ pub struct SimulateArgs {
     /// Seed of the sensor noise.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// Log rate (a divisor of the 20 kHz PWM rate is logged exactly; typical bench logs
+    /// are 1 kHz). [Hz]
+    #[arg(long, value_name = "HZ", default_value = "2000", value_parser = log_rate)]
+    pub log_rate: f64,
     /// Name the scenarios and exit.
     #[arg(long)]
     pub list: bool,
     /// Write a run summary as JSON, with the real-time factor (`-`: standard output).
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+}
+
+/// A log rate: positive and at most the 20 kHz PWM rate the telemetry is sampled at. [Hz]
+fn log_rate(s: &str) -> Result<f64, String> {
+    let v = positive_f64(s)?;
+    if v > 20_000.0 {
+        return Err(format!("{v} Hz is above the 20000 Hz telemetry rate"));
+    }
+    Ok(v)
 }
 
 /// `eha sweep-precharge`.

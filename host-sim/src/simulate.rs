@@ -201,7 +201,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         scenario,
         &RunOptions {
             duration_s: duration,
-            log_rate_hz: LOG_RATE_HZ,
+            log_rate_hz: args.log_rate,
             seed,
             progress: true,
             metadata,

@@ -114,8 +114,16 @@ fn every_bad_log_exits_2_naming_file_line_and_column_and_writes_nothing() {
         let log = dir.join(format!("{case}.csv"));
         fs::write(&log, text).unwrap();
         let json = dir.join("out.json");
+        let report = dir.join("report");
         for args in [
-            vec!["diagnose", s(&log), "--json", s(&json)],
+            vec![
+                "diagnose",
+                s(&log),
+                "--json",
+                s(&json),
+                "--report",
+                s(&report),
+            ],
             vec!["tune", s(&log), "--loop", "pressure", "--json", s(&json)],
         ] {
             let o = eha(&args);

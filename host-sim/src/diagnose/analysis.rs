@@ -30,7 +30,7 @@ use std::path::Path;
 
 /// Longest identification segment: the fit replays it once per evaluation, so this bounds
 /// the diagnosis's time on long logs (a few seconds hold every effect's signature). [s]
-pub const MAX_IDENTIFICATION_S: f64 = 4.0;
+pub const MAX_IDENTIFICATION_S: f64 = 3.0;
 
 /// Fraction of the nominal model's identification error a candidate must remove to be
 /// considered at all. [1]
@@ -301,8 +301,14 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             continue;
         }
         let ext_rig = f.candidate.rig_at(&f.u, rig);
-        let ext = predict_all(log, &ext_rig, f.candidate.phase_a_offset_a(&f.u))?;
-        let ext_val = fits_over(log, &ext.subsystem, val.clone());
+        let offset = f.candidate.phase_a_offset_a(&f.u);
+        // Only the candidate's own replay decides; the other predictors (and the closed
+        // loop) run once an extension is kept.
+        let own: BTreeMap<&'static str, Vec<f64>> =
+            predict(log, &ext_rig, f.candidate.predictor, usize::MAX, offset)?
+                .into_iter()
+                .collect();
+        let ext_val = fits_over(log, &own, val.clone());
         let base_val = calibrated_val.get(&f.candidate.predictor);
         let gain = f
             .candidate
@@ -312,7 +318,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             .filter_map(|s| Some(ext_val.get(*s)? - base_val?.get(*s)?))
             .fold(f64::NEG_INFINITY, f64::max);
         if gain >= MIN_VALIDATION_GAIN_POINTS {
-            kept = Some((i, ext));
+            kept = Some((i, predict_all(log, &ext_rig, offset)?));
             break;
         }
         notes.insert(

@@ -50,14 +50,14 @@ pub fn replay_electrical(log: &BenchLog, rig: &Rig, rows: usize) -> Option<Elect
         ud_v: Vec::with_capacity(n),
         uq_v: Vec::with_capacity(n),
     };
-    for k in 0..n {
+    for (k, &theta_k) in theta.iter().enumerate().take(n) {
         let (i_d, i_q) = (log.id_a[k], log.iq_a[k]);
         let w_e = pp * log.speed_rad_s[k];
         let mut u_d = m.r_s_ohm * i_d + m.l_d_h * deriv(&log.id_a, k) - w_e * m.l_q_h * i_q;
         let mut u_q =
             m.r_s_ohm * i_q + m.l_q_h * deriv(&log.iq_a, k) + w_e * (m.l_d_h * i_d + m.psi_f_wb);
         if loss_v > 0.0 {
-            let th = pp * theta[k];
+            let th = pp * theta_k;
             let (s, c) = th.sin_cos();
             // Phase currents (inverse Park, amplitude-invariant).
             let i_alpha = c * i_d - s * i_q;

@@ -16,7 +16,7 @@ use plant_model::Rig;
 
 /// Simplex iterations per candidate: enough to settle two coordinates to a few percent
 /// from a grid point (each iteration costs one or two replays).
-pub const SIMPLEX_ITERATIONS: u64 = 24;
+pub const SIMPLEX_ITERATIONS: u64 = 18;
 
 /// A candidate's fit.
 #[derive(Clone, Debug, PartialEq)]
