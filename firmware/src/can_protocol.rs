@@ -27,17 +27,19 @@
 //! | `0x210` | host → drive | `GetParameter` | 1   | `u8` parameter id                       |
 //! | `0x220` | host → drive | `SaveParameters` | 0 | — (allowed in Disabled only)            |
 //! | `0x230` | host → drive | `StepTest`     | 7   | `u8` loop (1 current, 2 speed, 3 pressure), `f32` amplitude [A, rad/s, Pa], `u16` duration [ms] |
+//! | `0x240` | host → drive | `Commission`   | 0   | — runs the commissioning sequence ([`crate::commissioning`]) in Calibrating |
 //!
 //! Mode codes: `0` disabled, `1` calibrating, `2` speed control, `3` pressure control.
 //!
 //! The configuration and test commands (`0x200`‥`0x230`) sit above the replies on purpose:
 //! set-points, mode changes and the drive's status win arbitration over them. Their ids
-//! `0x240`‥`0x270` are free for further configuration commands. Parameter ids, names,
+//! `0x250`‥`0x270` are free for further configuration commands. Parameter ids, names,
 //! units and bounds are the table of [`crate::parameters`]; values are IEEE-754 `f32`
 //! (little endian) in SI units, so a value read back is bit-identical to the one set.
 //! `SetParameter` is answered with a `Parameter` frame echoing the value now in use,
 //! `GetParameter` with a `Parameter` frame, `SaveParameters` and `StepTest` with a
-//! status (their function code in byte 6).
+//! status (their function code in byte 6); `Commission` is answered by the status frames,
+//! whose mode shows Calibrating while it runs (or a reject when the mode is refused).
 //!
 //! A command frame must have exactly the DLC in the table; remote (RTR) and extended
 //! (29-bit) frames are not part of the protocol (the application's acceptance filter
@@ -147,6 +149,8 @@ pub mod id {
     pub const SAVE_PARAMETERS: u16 = 0x220;
     /// `StepTest` command.
     pub const STEP_TEST: u16 = 0x230;
+    /// `Commission` command.
+    pub const COMMISSION: u16 = 0x240;
 }
 
 /// Mask selecting the node number of an identifier.
@@ -248,6 +252,8 @@ pub enum Function {
     SaveParameters,
     /// `StepTest`, code `0x23`.
     StepTest,
+    /// `Commission`, code `0x24`.
+    Commission,
 }
 
 impl Function {
@@ -263,6 +269,7 @@ impl Function {
             Function::GetParameter => id::GET_PARAMETER,
             Function::SaveParameters => id::SAVE_PARAMETERS,
             Function::StepTest => id::STEP_TEST,
+            Function::Commission => id::COMMISSION,
         }
     }
 
@@ -288,6 +295,7 @@ impl Function {
             id::GET_PARAMETER => Some(Function::GetParameter),
             id::SAVE_PARAMETERS => Some(Function::SaveParameters),
             id::STEP_TEST => Some(Function::StepTest),
+            id::COMMISSION => Some(Function::Commission),
             _ => None,
         }
     }
@@ -299,7 +307,10 @@ impl Function {
             Function::SetPressure | Function::SetSpeed => 4,
             Function::SetParameter => 5,
             Function::StepTest => 7,
-            Function::ClearFaults | Function::Heartbeat | Function::SaveParameters => 0,
+            Function::ClearFaults
+            | Function::Heartbeat
+            | Function::SaveParameters
+            | Function::Commission => 0,
         }
     }
 }
@@ -347,6 +358,8 @@ pub enum Request {
         /// How long the step is held. [ms]
         duration_ms: u16,
     },
+    /// Run the commissioning sequence (motor identification and gain design).
+    Commission,
 }
 
 impl Request {
@@ -376,6 +389,7 @@ impl Request {
             Request::GetParameter { .. } => Function::GetParameter,
             Request::SaveParameters => Function::SaveParameters,
             Request::StepTest { .. } => Function::StepTest,
+            Request::Commission => Function::Commission,
         }
     }
 
@@ -411,6 +425,7 @@ impl Request {
                 amplitude,
                 duration_s: f32::from(duration_ms) * 1e-3,
             },
+            Request::Commission => Command::Commission,
             Request::GetParameter { .. } | Request::SaveParameters => return None,
         })
     }
@@ -813,6 +828,7 @@ pub fn decode_command(frame: &Frame, node: NodeId) -> Result<Request, DecodeErro
             id: parameter_id(function, payload)?,
         }),
         Function::SaveParameters => Ok(Request::SaveParameters),
+        Function::Commission => Ok(Request::Commission),
         Function::StepTest => {
             let code = payload.first().copied().unwrap_or(0);
             let target =
@@ -868,7 +884,10 @@ pub fn encode_command(request: &Request, node: NodeId) -> Frame {
             write_f32(&mut data, 1, amplitude);
             data[5..7].copy_from_slice(&duration_ms.to_le_bytes());
         }
-        Request::ClearFaults | Request::Heartbeat | Request::SaveParameters => {}
+        Request::ClearFaults
+        | Request::Heartbeat
+        | Request::SaveParameters
+        | Request::Commission => {}
     }
     Frame {
         id,

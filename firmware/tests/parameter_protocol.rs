@@ -244,3 +244,21 @@ fn a_table_set_over_can_and_saved_is_there_after_a_reboot() {
         );
     }
 }
+
+#[test]
+fn a_commission_frame_starts_the_commissioning_sequence() {
+    // 0x240 + node, no payload, as `cansend can0 243#` sends it.
+    let frame = encode_command(&Request::Commission, node());
+    assert_eq!(frame.to_string(), "243#");
+    assert_eq!(decode_command(&frame, node()), Ok(Request::Commission));
+    let mut c = Controller::new(&Config::nominal());
+    assert_eq!(c.mode(), Mode::Disabled);
+    match serve(&Request::Commission, &mut c) {
+        Response::Ack(code) => assert_eq!(code, 0x24),
+        other => panic!("a commission request is acknowledged, got {other:?}"),
+    }
+    assert_eq!(c.mode(), Mode::Calibrating);
+    // A frame with a payload is not a Commission command.
+    let bad = Frame::new(0x243, &[0]).unwrap();
+    assert!(decode_command(&bad, node()).is_err());
+}
