@@ -186,7 +186,7 @@ fn show_fit(f: Option<f64>) -> String {
 }
 
 #[test]
-#[ignore = "issue 5 is open: the diagnosis passes 12 of the 36 seeds (dead time, gas loss or \
+#[ignore = "issue 5 is open: the diagnosis passes 13 of the 36 seeds (dead time, gas loss or \
             overcharge, transducer lag, shaft and cylinder friction, leakage in holding, none in \
             holding); run with `cargo test -p tests --test blind_identification -- --ignored \
             --nocapture` for the table"]

@@ -6,10 +6,10 @@
 //! parameters, so one optimiser serves them all: positive quantities are searched in
 //! logarithm (their plausible ranges span decades), signed ones linearly, phases as angles.
 //!
-//! The last coordinate is a tolerance, not a fault: the scale of the quantity that couples
-//! the subsystem's input to its output (the pump's displacement for the hydraulics, the
-//! magnet flux, i.e. the torque constant, for the motor), within a few percent of the rig
-//! file ([`TOLERANCE_STEP`] per unit, clamped to ±[`TOLERANCE_LIMIT`] units). A real rig is
+//! The last coordinates are tolerances, not faults: the scales of the quantities that
+//! couple the subsystem's input to its output (the pump's displacement and the absorber's
+//! gas volume for the hydraulics, the magnet flux, i.e. the torque constant, for the
+//! motor), within a few percent of the rig file ([`TOLERANCE_STEP`] per unit, clamped to ±[`TOLERANCE_LIMIT`] units). A real rig is
 //! never exactly its rig file; without this coordinate a Coulomb friction would absorb a 3 %
 //! torque-constant error and an air content a 3 % displacement error, and be named. The
 //! `none` candidate fits only this coordinate: the nominal model within its tolerances.
@@ -23,6 +23,15 @@ pub const TOLERANCE_STEP: f64 = 0.02;
 
 /// Largest tolerance excursion, in search units (±5 %). [1]
 pub const TOLERANCE_LIMIT: f64 = 2.5;
+
+/// Tolerance coordinates of a predictor's candidates.
+pub fn tolerance_dims(p: Predictor) -> usize {
+    match p {
+        Predictor::Hydraulics => 2,
+        Predictor::Motor => 1,
+        Predictor::Electrical => 0,
+    }
+}
 
 /// One candidate effect with its search space.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,26 +81,26 @@ pub fn kinematic_ripple_ratio(z: u32) -> f64 {
 }
 
 impl Candidate {
-    /// Whether the last search coordinate is the tolerance scale.
-    pub fn has_tolerance(&self) -> bool {
-        matches!(self.predictor, Predictor::Hydraulics | Predictor::Motor)
-    }
-
-    /// The tolerance scale at `u` (1 without one). [1]
-    pub fn tolerance_scale(&self, u: &[f64]) -> f64 {
-        match (self.has_tolerance(), u.last()) {
-            (true, Some(t)) => (TOLERANCE_STEP * t.clamp(-TOLERANCE_LIMIT, TOLERANCE_LIMIT)).exp(),
-            _ => 1.0,
+    /// The tolerance scales at `u`, last coordinates (1 where there is none). [1]
+    pub fn tolerance_scales(&self, u: &[f64]) -> [f64; 2] {
+        let dims = tolerance_dims(self.predictor);
+        let mut k = [1.0; 2];
+        for (j, t) in u[u.len().saturating_sub(dims)..].iter().enumerate() {
+            k[j] = (TOLERANCE_STEP * t.clamp(-TOLERANCE_LIMIT, TOLERANCE_LIMIT)).exp();
         }
+        k
     }
 
-    /// The rig at search point `u`: `nominal` with the tolerance scale and the effect.
+    /// The rig at search point `u`: `nominal` with the tolerance scales and the effect.
     pub fn rig_at(&self, u: &[f64], nominal: &Rig) -> Rig {
         let mut rig = nominal.clone();
-        let k = self.tolerance_scale(u);
+        let [k0, k1] = self.tolerance_scales(u);
         match self.predictor {
-            Predictor::Hydraulics => rig.pump.displacement_m3_per_rev *= k,
-            Predictor::Motor => rig.motor.psi_f_wb *= k,
+            Predictor::Hydraulics => {
+                rig.pump.displacement_m3_per_rev *= k0;
+                rig.absorber.shell_volume_m3 *= k1;
+            }
+            Predictor::Motor => rig.motor.psi_f_wb *= k0,
             Predictor::Electrical => {}
         }
         self.effect(u, nominal).apply(&mut rig);
@@ -279,10 +288,7 @@ pub fn candidates(
     cogging_orders: &[u32],
 ) -> Vec<Candidate> {
     let one = |name, predictor: Predictor, grid: Vec<f64>, dims: usize| {
-        let tolerance = usize::from(matches!(
-            predictor,
-            Predictor::Hydraulics | Predictor::Motor
-        ));
+        let tolerance = tolerance_dims(predictor);
         let mut step = vec![0.5; dims];
         step.extend(std::iter::repeat_n(1.0, tolerance));
         Candidate {
