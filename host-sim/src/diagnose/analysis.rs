@@ -219,7 +219,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     }
     // 4. Candidates fitted on the identification rows.
     let cands = candidates(rig, theta.is_some(), piston_moves(log), &cogging_orders);
-    let baseline_sse: BTreeMap<Predictor, Vec<(&'static str, f64)>> = predictors(log)
+    let targets: BTreeMap<Predictor, Target> = predictors(log)
         .into_iter()
         .map(|p| {
             let pred: Predicted = p
@@ -227,36 +227,13 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
                 .iter()
                 .filter_map(|s| Some((*s, baseline.get(s)?.clone())))
                 .collect();
-            let target = Target {
-                log,
-                rig,
-                rows: split,
-                from,
-                baseline_sse: Vec::new(),
-            };
-            (p, target.sse(&pred))
+            (p, Target::new(log, rig, split, from, &pred))
         })
+        .filter(|(_, t)| !t.baseline_sse.is_empty())
         .collect();
-    let usable: Vec<&Candidate> = cands
-        .iter()
-        .filter(|c| {
-            baseline_sse
-                .get(&c.predictor)
-                .is_some_and(|v| !v.is_empty())
-        })
-        .collect();
-    let fits: Vec<CandidateFit> = usable
+    let fits: Vec<CandidateFit> = cands
         .par_iter()
-        .map(|c| {
-            let target = Target {
-                log,
-                rig,
-                rows: split,
-                from,
-                baseline_sse: baseline_sse[&c.predictor].clone(),
-            };
-            fit(&target, c)
-        })
+        .filter_map(|c| Some(fit(targets.get(&c.predictor)?, c)))
         .collect();
     // The nominal model within its tolerances, per predictor: the reference every
     // candidate of that predictor must beat (costs become relative to it).

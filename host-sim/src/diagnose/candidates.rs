@@ -15,6 +15,7 @@
 //! `none` candidate fits only this coordinate: the nominal model within its tolerances.
 
 use super::predict::Predictor;
+use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::{Effect, Rig};
 use std::f64::consts::PI;
 
@@ -66,18 +67,6 @@ pub enum Structure {
 /// [(m³/s)/Pa]
 fn nominal_leakage(rig: &Rig) -> f64 {
     rig.pump.internal_leakage_m3_s_pa + rig.pump.external_leakage_m3_s_pa
-}
-
-/// The kinematic peak-to-peak flow ripple over mean flow of an axial piston pump with `z`
-/// pistons (eq. 21): (π/2z)·tan(π/4z) for odd z, (π/z)·tan(π/2z) for even z (1.52 % for
-/// z = 9, 7.8 % for z = 8).
-pub fn kinematic_ripple_ratio(z: u32) -> f64 {
-    let z = z.max(1) as f64;
-    if z as u32 % 2 == 1 {
-        PI / (2.0 * z) * (PI / (4.0 * z)).tan()
-    } else {
-        PI / z * (PI / (2.0 * z)).tan()
-    }
 }
 
 impl Candidate {

@@ -14,6 +14,8 @@
 //! This replay is algebraic (no state), so it costs one pass over the log.
 
 use crate::bench_log::BenchLog;
+use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
+use plant_model::rig::InverterParams;
 use plant_model::Rig;
 
 /// Predicted commanded voltages, row for row. [V]
@@ -35,8 +37,12 @@ pub fn replay_electrical(log: &BenchLog, rig: &Rig, rows: usize) -> Option<Elect
     let u_dc = log.udc_v.as_deref().map_or(rig.inverter.u_dc_v, |u| {
         u.iter().sum::<f64>() / u.len() as f64
     });
-    let loss_v = 2.0 * rig.inverter.dead_time_s * rig.inverter.pwm_frequency_hz * u_dc;
-    let band = rig.inverter.dead_time_current_band_a.max(1e-9);
+    // The plant's own inverter model at the logged DC link: its pole voltages at zero duty
+    // are minus the dead-time loss of each leg.
+    let inverter = Inverter::new(&InverterParams {
+        u_dc_v: u_dc,
+        ..rig.inverter.clone()
+    });
     let t = &log.t_s;
     let deriv = |y: &[f64], k: usize| {
         let (a, b) = (k.saturating_sub(1), (k + 1).min(log.len() - 1));
@@ -56,23 +62,13 @@ pub fn replay_electrical(log: &BenchLog, rig: &Rig, rows: usize) -> Option<Elect
         let mut u_d = m.r_s_ohm * i_d + m.l_d_h * deriv(&log.id_a, k) - w_e * m.l_q_h * i_q;
         let mut u_q =
             m.r_s_ohm * i_q + m.l_q_h * deriv(&log.iq_a, k) + w_e * (m.l_d_h * i_d + m.psi_f_wb);
-        if loss_v > 0.0 {
-            let th = pp * theta_k;
-            let (s, c) = th.sin_cos();
-            // Phase currents (inverse Park, amplitude-invariant).
-            let i_alpha = c * i_d - s * i_q;
-            let i_beta = s * i_d + c * i_q;
-            let i_abc = [
-                i_alpha,
-                -0.5 * i_alpha + 0.5 * 3f64.sqrt() * i_beta,
-                -0.5 * i_alpha - 0.5 * 3f64.sqrt() * i_beta,
-            ];
-            let e = i_abc.map(|i| loss_v * (i / band).clamp(-1.0, 1.0));
-            // Clarke removes the common mode; the loss is added back to the command.
-            let e_alpha = (2.0 * e[0] - e[1] - e[2]) / 3.0;
-            let e_beta = (e[1] - e[2]) / 3f64.sqrt();
-            u_d += c * e_alpha + s * e_beta;
-            u_q += -s * e_alpha + c * e_beta;
+        if inverter.has_dead_time() {
+            let (s, c) = (pp * theta_k).sin_cos();
+            let i_abc = dq_to_abc(i_d, i_q, s, c);
+            // The star point removes the common mode; the controller adds the loss back.
+            let (loss_d, loss_q) = pole_to_dq(&inverter.pole_voltages(&[0.0; 3], &i_abc), s, c);
+            u_d -= loss_d;
+            u_q -= loss_q;
         }
         out.ud_v.push(u_d);
         out.uq_v.push(u_q);

@@ -41,8 +41,11 @@ pub struct Target<'a> {
     pub rows: usize,
     /// First row scored (the replays' start-up rows are skipped).
     pub from: usize,
+    /// Each scored signal's noise variance over the scored rows (see [`noise_variance`]),
+    /// measured once: it is a property of the log, not of the candidate. [unit²]
+    noise: Vec<(&'static str, f64)>,
     /// The nominal model's squared error per signal over the scored rows, in units of the
-    /// signal's noise variance (see [`noise_variance`]).
+    /// signal's noise variance.
     pub baseline_sse: Vec<(&'static str, f64)>,
 }
 
@@ -58,18 +61,48 @@ pub fn noise_variance(y: &[f64]) -> f64 {
     v.max(f64::MIN_POSITIVE)
 }
 
-impl Target<'_> {
+impl<'a> Target<'a> {
+    /// The target of rows `from..rows` of `log`, against the nominal model's prediction
+    /// `baseline` of the signals a predictor scores (the log's signals it lacks are left
+    /// out).
+    pub fn new(
+        log: &'a BenchLog,
+        rig: &'a Rig,
+        rows: usize,
+        from: usize,
+        baseline: &Predicted,
+    ) -> Target<'a> {
+        let rows = rows.min(log.len());
+        let noise = baseline
+            .iter()
+            .filter_map(|(name, _)| {
+                let y = log.column(crate::bench_log::Signal::from_name(name)?)?;
+                Some((*name, noise_variance(&y[from.min(rows)..rows])))
+            })
+            .collect();
+        let mut target = Target {
+            log,
+            rig,
+            rows,
+            from,
+            noise,
+            baseline_sse: Vec::new(),
+        };
+        target.baseline_sse = target.sse(baseline);
+        target
+    }
+
     /// Sum of squared errors per signal of `predicted` over the scored rows, in units of
     /// the signal's noise variance there. [1]
     pub fn sse(&self, predicted: &Predicted) -> Vec<(&'static str, f64)> {
         predicted
             .iter()
             .filter_map(|(name, y_hat)| {
+                let noise = self.noise.iter().find(|(s, _)| s == name)?.1;
                 let y = self
                     .log
                     .column(crate::bench_log::Signal::from_name(name)?)?;
                 let end = self.rows.min(y_hat.len()).min(y.len());
-                let noise = noise_variance(&y[self.from..end]);
                 let e: f64 = (self.from..end).map(|k| (y[k] - y_hat[k]).powi(2)).sum();
                 Some((*name, if e.is_finite() { e / noise } else { f64::MAX }))
             })

@@ -42,6 +42,7 @@
 
 use crate::bench_log::{BenchLog, BenchLogError};
 use firmware::speed_observer::SpeedObserver;
+use firmware::transforms::{clarke, park, sin_cos};
 use plant_model::{Drive, InitialConditions, Inputs, Plant, Rig, RigError};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -336,13 +337,13 @@ fn simulate(
                     correction_a = torque / k_t;
                     i_q += correction_a;
                     if offset_a != 0.0 {
-                        // Amplitude-invariant Clarke of (offset, 0, 0) is (offset, offset/√3);
-                        // the controller measured true + offset, so the truth is less it.
-                        let th = pole_pairs * o.theta_m_rad;
-                        let (s, c) = (th.sin(), th.cos());
-                        let (a, b) = (offset_a, offset_a / 3f64.sqrt());
-                        i_d -= a * c + b * s;
-                        i_q -= -a * s + b * c;
+                        // The controller measured true + offset on phase a and transformed
+                        // it with its own Clarke and Park: the truth is the log less that
+                        // image.
+                        let sc = sin_cos((pole_pairs * o.theta_m_rad) as f32);
+                        let image = park(clarke(offset_a as f32, 0.0, 0.0), sc);
+                        i_d -= image.d as f64;
+                        i_q -= image.q as f64;
                     }
                     Drive::Currents { i_d, i_q }
                 }
