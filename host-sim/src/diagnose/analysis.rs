@@ -30,7 +30,7 @@ use std::path::Path;
 
 /// Longest identification segment: the fit replays it once per evaluation, so this bounds
 /// the diagnosis's time on long logs (a few seconds hold every effect's signature). [s]
-pub const MAX_IDENTIFICATION_S: f64 = 3.0;
+pub const MAX_IDENTIFICATION_S: f64 = 2.5;
 
 /// Fraction of the nominal model's identification error a candidate must remove to be
 /// considered at all. [1]
