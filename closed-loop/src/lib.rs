@@ -138,6 +138,12 @@ impl ClosedLoop {
         self.external_torque_nm = torque_nm;
     }
 
+    /// Turns the plant's shaft by `delta_rad` now, leaving its speed and every other state
+    /// alone (a replay's kinematic phase lock, see [`Plant::shift_shaft_angle`]). [rad]
+    pub fn shift_shaft_angle(&mut self, delta_rad: f64) {
+        self.plant.shift_shaft_angle(delta_rad);
+    }
+
     /// One PWM period: scenario commands due now, sample, control, integrate.
     pub fn step(&mut self) -> Sample {
         self.step_with(|m| m)

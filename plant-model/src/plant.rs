@@ -460,6 +460,24 @@ impl Plant {
         Ok(plant)
     }
 
+    /// Turns the shaft's angle by `delta_rad` without touching its speed or any other state:
+    /// a replay's kinematic phase lock, which keeps a simulated shaft in step with a logged
+    /// angle without a torque the controller would have to answer. Non-finite `delta_rad`
+    /// does nothing. [rad]
+    pub fn shift_shaft_angle(&mut self, delta_rad: f64) {
+        if !delta_rad.is_finite() {
+            return;
+        }
+        let theta = self.x[ix::THETA] + delta_rad;
+        self.x[ix::THETA] = theta;
+        self.rotor = RotorPhasor {
+            theta,
+            phasor: Phasor::of(theta),
+            rotations: 0,
+        };
+        self.angle = self.angle_terms_of(theta, self.rotor.phasor);
+    }
+
     /// Time since the start of the run. [s]
     pub fn time_s(&self) -> f64 {
         self.t_s

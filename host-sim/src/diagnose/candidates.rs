@@ -28,8 +28,8 @@ pub const TOLERANCE_LIMIT: f64 = 2.5;
 /// Tolerance coordinates of a predictor's candidates.
 pub fn tolerance_dims(p: Predictor) -> usize {
     match p {
-        Predictor::Hydraulics => 2,
-        Predictor::Motor => 1,
+        Predictor::Hydraulics | Predictor::Cylinder => 2,
+        Predictor::Motor | Predictor::ClosedLoop => 1,
         Predictor::Electrical => 0,
     }
 }
@@ -45,6 +45,9 @@ pub struct Candidate {
     pub structure: Structure,
     /// Start of the search. [search units]
     pub start: Vec<f64>,
+    /// A second start the grid is also tried from (the calibrated tolerances of the
+    /// predictor's `none` fit); empty when there is none. [search units]
+    pub alternative_start: Vec<f64>,
     /// Initial simplex step per search coordinate. [search units]
     pub step: Vec<f64>,
     /// Coarse grid over the first coordinate, tried before the simplex so it starts in the
@@ -85,11 +88,11 @@ impl Candidate {
         let mut rig = nominal.clone();
         let [k0, k1] = self.tolerance_scales(u);
         match self.predictor {
-            Predictor::Hydraulics => {
+            Predictor::Hydraulics | Predictor::Cylinder => {
                 rig.pump.displacement_m3_per_rev *= k0;
                 rig.absorber.shell_volume_m3 *= k1;
             }
-            Predictor::Motor => rig.motor.psi_f_wb *= k0,
+            Predictor::Motor | Predictor::ClosedLoop => rig.motor.psi_f_wb *= k0,
             Predictor::Electrical => {}
         }
         self.effect(u, nominal).apply(&mut rig);
@@ -270,12 +273,20 @@ fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 
 /// Every candidate the log can show, given which predictors it supports and the orders the
 /// residual spectrum points at (`cogging_orders`; the rig's slot/pole order when empty).
+/// `closed_loop`: the log's setpoints can be replayed, so the angle-locked torque effects
+/// are fitted on the closed loop, else on the motor replay.
 pub fn candidates(
     rig: &Rig,
     has_angle: bool,
     piston_moves: bool,
+    closed_loop: bool,
     cogging_orders: &[u32],
 ) -> Vec<Candidate> {
+    let ripple = if closed_loop {
+        Predictor::ClosedLoop
+    } else {
+        Predictor::Motor
+    };
     let one = |name, predictor: Predictor, grid: Vec<f64>, dims: usize| {
         let tolerance = tolerance_dims(predictor);
         let mut step = vec![0.5; dims];
@@ -285,6 +296,7 @@ pub fn candidates(
             predictor,
             structure: Structure::None,
             start: vec![0.0; dims + tolerance],
+            alternative_start: Vec::new(),
             step,
             grid,
         }
@@ -331,15 +343,24 @@ pub fn candidates(
         ),
     ];
     if piston_moves {
+        out.push(one("none", Predictor::Cylinder, log_grid(-2.0, 2.0, 5), 0));
         // ln(F_c/300 N): 25 N to 5 kN.
         out.push(one(
             "cylinder_friction",
-            Predictor::Hydraulics,
+            Predictor::Cylinder,
             log_grid(-2.5, 2.8, 7),
             2,
         ));
     }
     if has_angle {
+        if closed_loop {
+            out.push(one(
+                "none",
+                Predictor::ClosedLoop,
+                log_grid(-2.0, 2.0, 5),
+                0,
+            ));
+        }
         out.push(one(
             "dead_time",
             Predictor::Electrical,
@@ -349,13 +370,13 @@ pub fn candidates(
         // Offset / 0.5 A, both signs up to 2 A.
         out.push(one(
             "current_sensor_offset",
-            Predictor::Motor,
+            ripple,
             vec![-4.0, -2.0, -1.0, -0.4, 0.4, 1.0, 2.0, 4.0],
             1,
         ));
         // ln(T6/0.02), phase: the grid is over the phase at a mid amplitude; the simplex
         // then moves both.
-        let mut flux = one("flux_harmonics", Predictor::Motor, Vec::new(), 2);
+        let mut flux = one("flux_harmonics", ripple, Vec::new(), 2);
         flux.grid = log_grid(-PI, PI * 0.75, 8);
         out.push(flux);
         let orders: Vec<u32> = if cogging_orders.is_empty() {
@@ -364,7 +385,7 @@ pub fn candidates(
             cogging_orders.to_vec()
         };
         for k in orders {
-            let mut c = one("cogging_torque", Predictor::Motor, Vec::new(), 2);
+            let mut c = one("cogging_torque", ripple, Vec::new(), 2);
             c.structure = Structure::Order(k);
             c.grid = log_grid(-PI, PI * 0.75, 8);
             out.push(c);

@@ -4,8 +4,8 @@
 //! best grid point.
 //!
 //! The cost is the candidate's replay error on its own signals over the identification
-//! rows, each signal's squared error in units of its noise variance, summed, over the
-//! nominal model's: 1 is "explains nothing", 0 "explains everything".
+//! rows: each signal's squared error over the nominal model's, their geometric mean over
+//! the signals: 1 is "explains nothing", 0 "explains everything".
 
 use super::candidates::{grid_is_phase, Candidate};
 use super::predict::{predict, Predicted};
@@ -124,21 +124,30 @@ impl<'a> Target<'a> {
         ) else {
             return f64::MAX;
         };
-        // Signals in noise units, summed: the one far above its noise dominates, as in a
-        // likelihood with white measurement noise.
-        let mut total = 0.0;
-        let mut base = 0.0;
+        // Each signal's squared error relative to the nominal model's, combined as a
+        // geometric mean: the likelihood of white residuals whose variance per signal is
+        // unknown (maximised over it, it is Π sse_s^(−N/2)). A fixed noise variance per
+        // signal would not do: the speed the motor replay predicts carries, besides the
+        // log's own noise, the current sensor's noise integrated through the shaft, so its
+        // floor is far above the log's sample-to-sample noise and it would drown the
+        // current's evidence.
+        let mut log_ratio = 0.0;
+        let mut signals = 0usize;
         for (name, e) in self.sse(&p) {
             if let Some((_, b)) = self.baseline_sse.iter().find(|(s, _)| *s == name) {
-                total += e;
-                base += b;
+                if *b > 0.0 {
+                    if !e.is_finite() || e >= f64::MAX {
+                        return f64::MAX;
+                    }
+                    log_ratio += (e.max(f64::MIN_POSITIVE) / b).ln();
+                    signals += 1;
+                }
             }
         }
-        if base > 0.0 && total.is_finite() {
-            total / base
-        } else {
-            f64::MAX
+        if signals == 0 {
+            return f64::MAX;
         }
+        (log_ratio / signals as f64).exp()
     }
 }
 
@@ -168,18 +177,22 @@ pub fn fit(target: &Target<'_>, c: &Candidate) -> CandidateFit {
     };
     let mut best = (c.start.clone(), f64::MAX);
     let phase_grid = grid_is_phase(c);
-    for g in &c.grid {
-        let mut u = c.start.clone();
-        if c.name == "none" {
-            u[0] = *g;
-        } else if phase_grid {
-            u[1] = *g;
-        } else {
-            u[0] = *g;
-        }
-        let cost = problem.cost(&u).unwrap_or(f64::MAX);
-        if cost < best.1 {
-            best = (u, cost);
+    let starts = std::iter::once(&c.start)
+        .chain(Some(&c.alternative_start).filter(|s| s.len() == c.start.len()));
+    for start in starts {
+        for g in &c.grid {
+            let mut u = start.clone();
+            if c.name == "none" {
+                u[0] = *g;
+            } else if phase_grid {
+                u[1] = *g;
+            } else {
+                u[0] = *g;
+            }
+            let cost = problem.cost(&u).unwrap_or(f64::MAX);
+            if cost < best.1 {
+                best = (u, cost);
+            }
         }
     }
     let simplex: Vec<Vec<f64>> = std::iter::once(best.0.clone())

@@ -1,0 +1,25 @@
+//! Writes the blind suite's log of each seed given on the command line into a directory and
+//! prints what was hidden: a tool to inspect one seed with `eha diagnose` or a probe
+//! (`cargo run --release -p tests --example blind_log -- DIR SEED…`).
+
+use std::path::PathBuf;
+use tests::blind::generate;
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let dir = PathBuf::from(args.next().expect("usage: blind_log DIR SEED…"));
+    std::fs::create_dir_all(&dir).expect("create the directory");
+    for seed in args {
+        let seed: u64 = seed.parse().expect("a seed is an unsigned integer");
+        let (path, truth) = generate(seed, &dir).expect("generate the log");
+        let target = dir.join(format!("seed-{seed}.csv"));
+        std::fs::rename(&path, &target).expect("rename the log");
+        println!(
+            "{seed}: {} {:?} {} {}",
+            truth.effect_name,
+            truth.parameters,
+            truth.scenario,
+            target.display()
+        );
+    }
+}
