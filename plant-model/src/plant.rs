@@ -316,6 +316,17 @@ struct RotorPhasor {
     rotations: u32,
 }
 
+impl RotorPhasor {
+    /// The phasor computed afresh from the angle (one `sincos`).
+    fn at(theta: f64) -> RotorPhasor {
+        RotorPhasor {
+            theta,
+            phasor: Phasor::of(theta),
+            rotations: 0,
+        }
+    }
+}
+
 /// Steps carried by rotation before the rotor phasor is computed afresh.
 const ROTOR_RESYNC_STEPS: u32 = 1024;
 
@@ -436,11 +447,7 @@ impl Plant {
             projection_loss_j: 0.0,
             stored0_j: 0.0,
             last_inputs: Inputs::duties([0.5; 3], false),
-            rotor: RotorPhasor {
-                theta: init.theta_m_rad,
-                phasor: Phasor::of(init.theta_m_rad),
-                rotations: 0,
-            },
+            rotor: RotorPhasor::at(init.theta_m_rad),
             angle: AngleTerms {
                 theta: f64::NAN,
                 rot_m: Phasor { cos: 1.0, sin: 0.0 },
@@ -470,12 +477,14 @@ impl Plant {
         }
         let theta = self.x[ix::THETA] + delta_rad;
         self.x[ix::THETA] = theta;
-        self.rotor = RotorPhasor {
-            theta,
-            phasor: Phasor::of(theta),
-            rotations: 0,
-        };
+        self.rotor = RotorPhasor::at(theta);
         self.angle = self.angle_terms_of(theta, self.rotor.phasor);
+    }
+
+    /// The shaft's true angle, unwrapped (what [`Plant::observe`] reports as `theta_m_rad`,
+    /// without evaluating the rest of the observables). [rad]
+    pub fn shaft_angle_rad(&self) -> f64 {
+        self.x[ix::THETA]
     }
 
     /// Time since the start of the run. [s]
@@ -740,11 +749,7 @@ impl Plant {
         }
         let theta = self.x[ix::THETA];
         self.rotor = if self.rotor.rotations >= ROTOR_RESYNC_STEPS {
-            RotorPhasor {
-                theta,
-                phasor: Phasor::of(theta),
-                rotations: 0,
-            }
+            RotorPhasor::at(theta)
         } else {
             RotorPhasor {
                 theta,

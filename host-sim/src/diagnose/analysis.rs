@@ -183,6 +183,18 @@ fn fit_of(
     }
 }
 
+/// The identification segment of a checked `log` (at least a few rows): its end row
+/// `split` (the validation segment is `split..`) and the first row scored, `from` (the
+/// replays' start-up rows are skipped).
+pub fn segments(log: &BenchLog) -> (usize, usize) {
+    let n = log.len();
+    let t = &log.t_s;
+    let t_mid = t[0] + 0.5 * (t[n - 1] - t[0]);
+    let t_split = t_mid.min(t[0] + MAX_IDENTIFICATION_S);
+    let split = t.partition_point(|x| *x < t_split).clamp(2, n - 1);
+    (split, INITIAL_SAMPLES.min(split / 4))
+}
+
 /// Runs the whole analysis.
 pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     log.check(Path::new("bench log being diagnosed"))
@@ -191,10 +203,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     let n = log.len();
     let t = &log.t_s;
     // 1. Segments.
-    let t_mid = t[0] + 0.5 * (t[n - 1] - t[0]);
-    let t_split = t_mid.min(t[0] + MAX_IDENTIFICATION_S);
-    let split = t.partition_point(|x| *x < t_split).clamp(2, n - 1);
-    let from = INITIAL_SAMPLES.min(split / 4);
+    let (split, from) = segments(log);
     // 2. Baseline.
     let mut base_pred = predict_all(log, rig, 0.0, Predictor::Hydraulics)?;
     let baseline = base_pred.subsystem.clone();
@@ -238,11 +247,21 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         has_closed_loop,
         &cogging_orders,
     );
+    // The free-payload pressure replay, only when the piston moves: the baseline of the
+    // cylinder's candidates, and the contract's baseline pressure if one of them is kept.
+    let cylinder_baseline: BTreeMap<&'static str, Vec<f64>> =
+        if predictors(log).contains(&Predictor::Cylinder) {
+            predict(log, rig, Predictor::Cylinder, usize::MAX, 0.0)?
+                .into_iter()
+                .collect()
+        } else {
+            BTreeMap::new()
+        };
     let targets: BTreeMap<Predictor, Target> = predictors(log)
         .into_iter()
         .map(|p| {
             let pred: Predicted = if p == Predictor::Cylinder {
-                predict(log, rig, p, usize::MAX, 0.0).unwrap_or_default()
+                cylinder_baseline.clone().into_iter().collect()
             } else if p == Predictor::ClosedLoop {
                 p.signals()
                     .iter()
@@ -363,7 +382,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             };
             if pressure == Predictor::Cylinder {
                 // Baseline and extension on the same replay, so the gain is the extension's.
-                base_pred = predict_all(log, rig, 0.0, pressure)?;
+                base_pred.subsystem.extend(cylinder_baseline.clone());
             }
             kept = Some((i, predict_all(log, &ext_rig, offset, pressure)?));
             break;
@@ -514,13 +533,8 @@ fn missing_order_line(
         .iter()
         .find(|(name, _)| *name == c.name)?
         .1;
-    let pp = rig.motor.pole_pairs;
-    let order = match (c.name, c.structure) {
-        ("cogging_torque", super::candidates::Structure::Order(k)) => k,
-        ("flux_harmonics", _) => 6 * pp,
-        _ => pp,
-    };
-    let Some((_, s)) = spectra.iter().find(|(n, _)| *n == "speed_rad_s") else {
+    let (signal, order) = angle_locked_order(c, rig)?;
+    let Some((_, s)) = spectra.iter().find(|(n, _)| *n == signal) else {
         return Some("no residual order spectrum (the shaft turned too little)".into());
     };
     let ratio = s.at(order) / s.floor(1, 200).max(f64::MIN_POSITIVE);
@@ -531,14 +545,11 @@ fn missing_order_line(
     })
 }
 
-/// A line of evidence from the residual spectrum for an angle-locked candidate.
-fn order_evidence(
-    c: &Candidate,
-    spectra: &[(&'static str, OrderSpectrum)],
-    rig: &Rig,
-) -> Option<String> {
+/// The residual signal and the order per revolution at which an angle-locked candidate
+/// shows; `None` for the others.
+fn angle_locked_order(c: &Candidate, rig: &Rig) -> Option<(&'static str, u32)> {
     let pp = rig.motor.pole_pairs;
-    let (signal, order) = match (c.name, c.structure) {
+    Some(match (c.name, c.structure) {
         ("cogging_torque", super::candidates::Structure::Order(k)) => ("speed_rad_s", k),
         ("flux_harmonics", _) => ("speed_rad_s", 6 * pp),
         ("current_sensor_offset", _) => ("speed_rad_s", pp),
@@ -546,7 +557,16 @@ fn order_evidence(
             ("p_pa", if z % 2 == 1 { 2 * z } else { z })
         }
         _ => return None,
-    };
+    })
+}
+
+/// A line of evidence from the residual spectrum for an angle-locked candidate.
+fn order_evidence(
+    c: &Candidate,
+    spectra: &[(&'static str, OrderSpectrum)],
+    rig: &Rig,
+) -> Option<String> {
+    let (signal, order) = angle_locked_order(c, rig)?;
     let (_, s) = spectra.iter().find(|(n, _)| *n == signal)?;
     let floor = s.floor(1, 200);
     Some(format!(

@@ -138,7 +138,7 @@ pub fn replay_closed_loop_rows(log: &BenchLog, rig: &Rig, rows: usize) -> Option
                 let f = (now - log.t_s[row]) / (log.t_s[row + 1] - log.t_s[row]);
                 let reference = th[row] + (th[row + 1] - th[row]) * f.clamp(0.0, 1.0);
                 // The simulated shaft starts at angle 0, the logged one at th[0].
-                let e = reference - th[0] - cl.plant().observe().theta_m_rad;
+                let e = reference - th[0] - cl.plant().shaft_angle_rad();
                 cl.shift_shaft_angle(pull * e);
             }
             last = cl.step();
