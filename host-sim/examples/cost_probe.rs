@@ -1,10 +1,12 @@
-//! Prints, for one log, a candidate's identification cost over a sweep of its first search
-//! coordinate (the others as given, else at their start), with each signal's squared error:
-//! a tool to see whether a replay can tell an effect at all and where its minimum lies
-//! (`cargo run --release -p host-sim --example cost_probe -- LOG.csv EFFECT [U1 …]`).
+//! Prints, for one log, a candidate's identification cost over a sweep of one search
+//! coordinate (the first, or the K-th with `--coord K`; a phase coordinate of a ripple is
+//! swept over a revolution), the others as given, else at their start, with each signal's
+//! squared error: a tool to see whether a replay can tell an effect at all and where its
+//! minimum lies
+//! (`cargo run --release -p host-sim --example cost_probe -- LOG.csv EFFECT [--coord K] [U1 …]`).
 
 use host_sim::diagnose::analysis::segments;
-use host_sim::diagnose::candidates::candidates;
+use host_sim::diagnose::candidates::{candidates, grid_is_phase};
 use host_sim::diagnose::closed_replay::scenario_of;
 use host_sim::diagnose::fit::Target;
 use host_sim::diagnose::predict::{piston_moves, predict};
@@ -15,7 +17,16 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let path = PathBuf::from(args.next().expect("usage: cost_probe LOG.csv EFFECT [U…]"));
     let name = args.next().expect("an effect name");
-    let given: Vec<f64> = args.map(|a| a.parse().expect("a number")).collect();
+    let mut rest: Vec<String> = args.collect();
+    let coord = match rest.first().map(String::as_str) {
+        Some("--coord") => {
+            let k = rest.get(1).and_then(|k| k.parse().ok()).expect("--coord K");
+            rest.drain(..2);
+            k
+        }
+        _ => 0,
+    };
+    let given: Vec<f64> = rest.iter().map(|a| a.parse().expect("a number")).collect();
     let log = host_sim::bench_log::read(&path).expect("a valid bench log");
     let rig = Rig::nominal();
     let closed_loop = log.theta_m_rad.is_some() && scenario_of(&log).is_some();
@@ -38,12 +49,19 @@ fn main() {
     for (k, v) in given.iter().enumerate().take(u.len()) {
         u[k] = *v;
     }
-    for g in [-3.0, -2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 3.0] {
-        u[0] = g;
+    let sweep: Vec<f64> = if coord == 1 && grid_is_phase(c) {
+        (0..12)
+            .map(|k| -std::f64::consts::PI + k as f64 * std::f64::consts::PI / 6.0)
+            .collect()
+    } else {
+        vec![-3.0, -2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 3.0]
+    };
+    for g in sweep {
+        u[coord] = g;
         let r = c.rig_at(&u, &rig);
         let p = predict(&log, &r, c.predictor, split, c.phase_a_offset_a(&u)).expect("replay");
         println!(
-            "u0 {g:+.1} {:?} cost {:.4} sse {:?}",
+            "u{coord} {g:+.2} {:?} cost {:.4} sse {:?}",
             c.parameters(&u, &rig),
             target.cost(c, &u),
             target.sse(&p)

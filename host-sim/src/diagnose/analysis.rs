@@ -89,23 +89,35 @@ fn predictors(log: &BenchLog) -> Vec<Predictor> {
 /// closed loop's.
 #[derive(Clone, Debug, Default)]
 pub struct Predictions {
-    /// Subsystem replays by signal.
+    /// Hydraulic, motor and electrical replays by signal.
     pub subsystem: BTreeMap<&'static str, Vec<f64>>,
-    /// Closed-loop replay by signal (empty when the log has no usable setpoint).
+    /// Speed and current loops replayed on the logged speed reference
+    /// ([`Predictor::ClosedLoop`]) by signal; empty without the shaft angle.
+    pub inner_loops: BTreeMap<&'static str, Vec<f64>>,
+    /// The whole closed loop replayed from the logged setpoints, by signal (empty when the
+    /// log has no usable setpoint).
     pub closed_loop: BTreeMap<&'static str, Vec<f64>>,
 }
 
 impl Predictions {
     /// The contract's per-signal predictions: pressure and voltages from the subsystem
-    /// replays (driven by the logged angle and currents), speed and currents from the
-    /// closed loop, which predicts them (the subsystem replays take them as inputs); the
-    /// motor replay's speed and needed current when there is no closed loop.
+    /// replays (driven by the logged angle and currents); speed and currents from the
+    /// control loops, which predict them (the subsystem replays take them as inputs). The
+    /// speed comes from the whole loop: in pressure control the logged speed reference is
+    /// the pressure loop's output, and the inner loops replayed on it would predict the
+    /// speed from itself. The q current comes from the inner loops where they ran (the
+    /// torque the shaft needed, without the pressure loop's answer to its transducer's
+    /// noise, which no noise-free replay reproduces), else from the whole loop. The motor
+    /// replay's speed and needed current stand when neither loop could be replayed.
     pub fn contract(&self) -> BTreeMap<&'static str, Vec<f64>> {
         let mut out = self.subsystem.clone();
         for (k, v) in &self.closed_loop {
             if *k != "p_pa" {
                 out.insert(k, v.clone());
             }
+        }
+        if let Some(iq) = self.inner_loops.get("iq_a") {
+            out.insert("iq_a", iq.clone());
         }
         out
     }
@@ -119,19 +131,19 @@ fn predict_all(
     phase_a_offset_a: f64,
     pressure: Predictor,
 ) -> Result<Predictions, ReplayError> {
-    let preds: Vec<Result<Predicted, ReplayError>> = predictors(log)
+    let preds: Vec<Result<(Predictor, Predicted), ReplayError>> = predictors(log)
         .into_par_iter()
-        .filter(|p| {
-            *p != Predictor::ClosedLoop
-                && (!matches!(p, Predictor::Hydraulics | Predictor::Cylinder) || *p == pressure)
-        })
-        .map(|p| predict(log, rig, p, usize::MAX, phase_a_offset_a))
+        .filter(|p| !matches!(p, Predictor::Hydraulics | Predictor::Cylinder) || *p == pressure)
+        .map(|p| Ok((p, predict(log, rig, p, usize::MAX, phase_a_offset_a)?)))
         .collect();
     let mut out = Predictions::default();
     for p in preds {
-        for (name, y) in p? {
-            out.subsystem.insert(name, y);
-        }
+        let (predictor, predicted) = p?;
+        let map = match predictor {
+            Predictor::ClosedLoop => &mut out.inner_loops,
+            _ => &mut out.subsystem,
+        };
+        map.extend(predicted);
     }
     if let Some(cl) = replay_closed_loop(log, rig) {
         out.closed_loop.insert("p_pa", cl.p_pa);
@@ -265,7 +277,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             } else if p == Predictor::ClosedLoop {
                 p.signals()
                     .iter()
-                    .filter_map(|s| Some((*s, base_pred.closed_loop.get(s)?.clone())))
+                    .filter_map(|s| Some((*s, base_pred.inner_loops.get(s)?.clone())))
                     .collect()
             } else {
                 p.signals()

@@ -14,16 +14,17 @@
 //!   it shows without that noise.
 //! - [`Predictor::Motor`]: the shaft speed `speed_rad_s` from the logged currents, and the
 //!   q current `iq_a` the model needed to follow the logged shaft motion.
-//! - [`Predictor::ClosedLoop`] ([`super::closed_replay`]): speed and q current of the whole
-//!   loop replayed from the logged setpoints, the shaft phase-locked to the logged angle.
-//!   Angle-locked torque ripple (cogging, flux harmonics, a current offset's first
-//!   harmonic) is fitted here: the speed loop's answer to it is what the log shows, and
-//!   only the loop itself predicts that answer's amplitude and phase; the motor replay,
-//!   driven by the logged current sampled at 1 kHz, sees a 65 Hz ripple with a timing
-//!   error of a fraction of a sample, i.e. tenths of a radian.
+//! - [`Predictor::ClosedLoop`] ([`super::closed_replay`]): speed and q current of the
+//!   speed and current loops replayed on the logged speed reference (in pressure control,
+//!   the pressure loop's output), the shaft phase-locked to the logged angle and the
+//!   cogging torque applied at the logged angle. Angle-locked torque ripple (cogging, flux
+//!   harmonics, a current offset's first harmonic) is fitted here: the speed loop's answer
+//!   to it is what the log shows, and only the loop itself predicts that answer's amplitude
+//!   and phase; the motor replay, driven by the logged current sampled at 1 kHz, sees a
+//!   65 Hz ripple with a timing error of a fraction of a sample, i.e. tenths of a radian.
 //! - [`Predictor::Electrical`] ([`super::electrical`]): the commanded `ud_v`, `uq_v`.
 
-use super::closed_replay::replay_closed_loop_rows;
+use super::closed_replay::{replay_closed_loop_rows, Reference};
 use super::electrical::replay_electrical;
 use super::replay::{replay_with, ReplayError, ReplayKind, ReplayOptions};
 use crate::bench_log::BenchLog;
@@ -44,7 +45,7 @@ pub enum Predictor {
     Motor,
     /// Commanded voltages from the currents and the speed.
     Electrical,
-    /// Speed and current of the whole loop from the logged setpoints.
+    /// Speed and current of the speed and current loops from the logged speed reference.
     ClosedLoop,
 }
 
@@ -67,7 +68,9 @@ impl Predictor {
             Predictor::Cylinder => "hydraulics driven by the logged shaft angle, payload simulated",
             Predictor::Motor => "motor and shaft driven by the logged currents",
             Predictor::Electrical => "stator voltages from the logged currents and speed",
-            Predictor::ClosedLoop => "the whole loop replayed from the logged setpoints",
+            Predictor::ClosedLoop => {
+                "speed and current loops replayed on the logged speed reference"
+            }
         }
     }
 }
@@ -115,10 +118,12 @@ pub fn predict(
             let r = replay_with(log, rig, ReplayKind::Motor, &options)?;
             vec![("speed_rad_s", r.speed_rad_s), ("iq_a", r.iq_needed_a)]
         }
-        Predictor::ClosedLoop => match replay_closed_loop_rows(log, rig, rows) {
-            Some(c) => vec![("speed_rad_s", c.speed_rad_s), ("iq_a", c.iq_a)],
-            None => Vec::new(),
-        },
+        Predictor::ClosedLoop => {
+            match replay_closed_loop_rows(log, rig, rows, Reference::SpeedReference) {
+                Some(c) => vec![("speed_rad_s", c.speed_rad_s), ("iq_a", c.iq_a)],
+                None => Vec::new(),
+            }
+        }
         Predictor::Electrical => match replay_electrical(log, rig, rows) {
             Some(e) => vec![("ud_v", e.ud_v), ("uq_v", e.uq_v)],
             None => Vec::new(),
