@@ -3,8 +3,9 @@
 //! swept over a revolution), the others as given, else at their start, with each signal's
 //! squared error: a tool to see whether a replay can tell an effect at all and where its
 //! minimum lies
-//! (`cargo run --release -p host-sim --example cost_probe -- LOG.csv EFFECT [--coord K] [U1 …]`).
+//! (`cargo run --release -p host-sim --example cost_probe -- LOG.csv EFFECT[/PREDICTOR] [--coord K] [U1 …]`).
 
+use closed_loop::ScenarioKind;
 use host_sim::diagnose::analysis::segments;
 use host_sim::diagnose::candidates::{candidates, grid_is_phase};
 use host_sim::diagnose::closed_replay::scenario_of;
@@ -17,6 +18,11 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let path = PathBuf::from(args.next().expect("usage: cost_probe LOG.csv EFFECT [U…]"));
     let name = args.next().expect("an effect name");
+    // EFFECT or EFFECT/PREDICTOR (e.g. extra_leakage/PressureLoop) when several replays fit it.
+    let (effect, predictor) = match name.split_once('/') {
+        Some((e, p)) => (e.to_string(), Some(p.to_string())),
+        None => (name.clone(), None),
+    };
     let mut rest: Vec<String> = args.collect();
     let coord = match rest.first().map(String::as_str) {
         Some("--coord") => {
@@ -30,16 +36,23 @@ fn main() {
     let log = host_sim::bench_log::read(&path).expect("a valid bench log");
     let rig = Rig::nominal();
     let closed_loop = log.theta_m_rad.is_some() && scenario_of(&log).is_some();
+    let pressure_loop = scenario_of(&log).is_some_and(|s| s.kind == ScenarioKind::PressureStep);
     let cands = candidates(
         &rig,
         log.theta_m_rad.is_some(),
         piston_moves(&log),
         closed_loop,
+        pressure_loop,
         &[rig.motor.cogging_fundamental_order()],
     );
     let c = cands
         .iter()
-        .find(|c| c.name == name)
+        .find(|c| {
+            c.name == effect
+                && predictor
+                    .as_ref()
+                    .is_none_or(|p| format!("{:?}", c.predictor) == *p)
+        })
         .expect("a candidate of that name");
     let (split, from) = segments(&log);
     let base = predict(&log, &rig, c.predictor, usize::MAX, 0.0).expect("replay");

@@ -165,6 +165,32 @@ impl BenchLog {
         self.t_s.is_empty()
     }
 
+    /// The log from row `from` on (clamped to the last row), its time restarted at zero.
+    pub fn tail(&self, from: usize) -> BenchLog {
+        let k = from.min(self.len().saturating_sub(1));
+        let cut = |v: &Vec<f64>| v.get(k..).map_or_else(Vec::new, <[f64]>::to_vec);
+        let cut_opt = |v: &Option<Vec<f64>>| v.as_ref().map(cut);
+        let t0 = self.t_s.get(k).copied().unwrap_or(0.0);
+        BenchLog {
+            metadata: self.metadata.clone(),
+            t_s: cut(&self.t_s).into_iter().map(|t| t - t0).collect(),
+            p_ref_pa: cut(&self.p_ref_pa),
+            p_pa: cut(&self.p_pa),
+            speed_rad_s: cut(&self.speed_rad_s),
+            iq_a: cut(&self.iq_a),
+            id_a: cut(&self.id_a),
+            theta_m_rad: cut_opt(&self.theta_m_rad),
+            x_m: cut_opt(&self.x_m),
+            p_low_pa: cut_opt(&self.p_low_pa),
+            speed_ref_rad_s: cut_opt(&self.speed_ref_rad_s),
+            iq_ref_a: cut_opt(&self.iq_ref_a),
+            ud_v: cut_opt(&self.ud_v),
+            uq_v: cut_opt(&self.uq_v),
+            udc_v: cut_opt(&self.udc_v),
+            oil_temp_c: cut_opt(&self.oil_temp_c),
+        }
+    }
+
     /// The value of the first metadata line with `key`.
     pub fn meta(&self, key: &str) -> Option<&str> {
         self.metadata

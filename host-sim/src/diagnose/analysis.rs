@@ -2,7 +2,8 @@
 //! explains it, with which parameters, and what that gains on data the fit never saw.
 //!
 //! 1. Segments: identification = the first half of the log (at most
-//!    [`MAX_IDENTIFICATION_S`]), validation = the rest.
+//!    [`MAX_IDENTIFICATION_S`]; half-way into a final pressure hold the first half does not
+//!    reach, see [`segments`]), validation = the rest.
 //! 2. Baseline: every subsystem replay ([`super::predict`]) and the closed loop
 //!    ([`super::closed_replay`]) on the nominal rig over the whole log; residuals.
 //! 3. Evidence: the residuals' order spectra against the shaft angle
@@ -15,7 +16,7 @@
 //!    validation segment; otherwise the answer is `none`.
 
 use super::candidates::{candidates, tolerance_dims, Candidate};
-use super::closed_replay::{replay_closed_loop, scenario_of};
+use super::closed_replay::{hold_scored_from, replay_closed_loop, scenario_of};
 use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 use super::fit::{fit, CandidateFit, Target};
 use super::predict::{piston_moves, predict, Predicted, Predictor};
@@ -23,6 +24,7 @@ use super::replay::{unwrap_angle, ReplayError, INITIAL_SAMPLES};
 use super::spectrum::{order_spectrum, OrderSpectrum};
 use super::{fit_percent, DiagnoseError};
 use crate::bench_log::{BenchLog, Signal};
+use closed_loop::ScenarioKind;
 use plant_model::Rig;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -39,6 +41,16 @@ pub const MIN_EXPLAINED: f64 = 0.2;
 /// Validation-fit improvement, on the candidate's own signals, below which an extension is
 /// not kept. [percentage points]
 pub const MIN_VALIDATION_GAIN_POINTS: f64 = 1.0;
+
+/// Rows of a settled final pressure hold below which the hold replay is not fitted (0.1 s
+/// at 1 kHz: the pressure loop's integral, which carries the leakage speed, settles in
+/// that time). [1]
+const MIN_HOLD_ROWS: usize = 100;
+
+/// Longest settled hold the hold replay is fitted on: its pump speed is a level, which a
+/// second of a hold fixes to the speed noise over √1000 (each evaluation replays the whole
+/// loop, the costliest of the replays). [s]
+const MAX_HOLD_IDENTIFICATION_S: f64 = 0.5;
 
 /// Everything the diagnosis computed, for the JSON and the report.
 pub struct Analysis {
@@ -81,6 +93,15 @@ fn predictors(log: &BenchLog) -> Vec<Predictor> {
     }
     if log.theta_m_rad.is_some() && scenario_of(log).is_some() {
         p.push(Predictor::ClosedLoop);
+    }
+    // A log that holds from the start has its leakage in the hydraulic replay's pressure
+    // drift over the identification segment; one whose final hold begins after the
+    // middle (a pressure step's fill) has it only in the hold's pump speed.
+    if scenario_of(log).is_some_and(|s| s.kind == ScenarioKind::PressureStep)
+        && hold_scored_from(log)
+            .is_some_and(|k| k + MIN_HOLD_ROWS < log.len() && log.t_s[k] > default_split_time(log))
+    {
+        p.push(Predictor::PressureLoop);
     }
     p
 }
@@ -131,11 +152,21 @@ fn predict_all(
     phase_a_offset_a: f64,
     pressure: Predictor,
 ) -> Result<Predictions, ReplayError> {
-    let preds: Vec<Result<(Predictor, Predicted), ReplayError>> = predictors(log)
-        .into_par_iter()
-        .filter(|p| !matches!(p, Predictor::Hydraulics | Predictor::Cylinder) || *p == pressure)
-        .map(|p| Ok((p, predict(log, rig, p, usize::MAX, phase_a_offset_a)?)))
-        .collect();
+    // The whole loop's replay (every signal it predicts) beside the others.
+    let (preds, whole): (Vec<Result<(Predictor, Predicted), ReplayError>>, _) = rayon::join(
+        || {
+            predictors(log)
+                .into_par_iter()
+                .filter(|p| match p {
+                    Predictor::Hydraulics | Predictor::Cylinder => *p == pressure,
+                    Predictor::PressureLoop => false,
+                    _ => true,
+                })
+                .map(|p| Ok((p, predict(log, rig, p, usize::MAX, phase_a_offset_a)?)))
+                .collect()
+        },
+        || replay_closed_loop(log, rig),
+    );
     let mut out = Predictions::default();
     for p in preds {
         let (predictor, predicted) = p?;
@@ -145,7 +176,7 @@ fn predict_all(
         };
         map.extend(predicted);
     }
-    if let Some(cl) = replay_closed_loop(log, rig) {
+    if let Some(cl) = whole {
         out.closed_loop.insert("p_pa", cl.p_pa);
         out.closed_loop.insert("speed_rad_s", cl.speed_rad_s);
         out.closed_loop.insert("iq_a", cl.iq_a);
@@ -198,13 +229,32 @@ fn fit_of(
 /// The identification segment of a checked `log` (at least a few rows): its end row
 /// `split` (the validation segment is `split..`) and the first row scored, `from` (the
 /// replays' start-up rows are skipped).
+///
+/// The split is the log's middle (at most [`MAX_IDENTIFICATION_S`] in), unless the log
+/// ends in a pressure hold the first half does not reach: a pressure step whose fill takes
+/// most of the log. Then the identification segment runs half-way into that hold's settled
+/// part ([`hold_scored_from`]), so the fit sees the regime the validation tests — the hold is where the leakage shows in
+/// the pump speed that replaces it, while in the fill it is a few percent of the pump's
+/// flow, where the rig's tolerances would mimic it.
 pub fn segments(log: &BenchLog) -> (usize, usize) {
     let n = log.len();
     let t = &log.t_s;
-    let t_mid = t[0] + 0.5 * (t[n - 1] - t[0]);
-    let t_split = t_mid.min(t[0] + MAX_IDENTIFICATION_S);
+    let mut t_split = default_split_time(log);
+    if let Some(t_hold) = hold_scored_from(log).and_then(|k| t.get(k)) {
+        if *t_hold > t_split {
+            t_split = t_hold + 0.5 * (t[n - 1] - t_hold);
+        }
+    }
     let split = t.partition_point(|x| *x < t_split).clamp(2, n - 1);
     (split, INITIAL_SAMPLES.min(split / 4))
+}
+
+/// The identification segment's end without a late final hold: the log's middle, at most
+/// [`MAX_IDENTIFICATION_S`] in. [s]
+fn default_split_time(log: &BenchLog) -> f64 {
+    let t = &log.t_s;
+    let (first, last) = (t[0], t[t.len() - 1]);
+    (first + 0.5 * (last - first)).min(first + MAX_IDENTIFICATION_S)
 }
 
 /// Runs the whole analysis.
@@ -251,12 +301,12 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         }
     }
     // 4. Candidates fitted on the identification rows.
-    let has_closed_loop = predictors(log).contains(&Predictor::ClosedLoop);
     let cands = candidates(
         rig,
         theta.is_some(),
         piston_moves(log),
-        has_closed_loop,
+        predictors(log).contains(&Predictor::ClosedLoop),
+        predictors(log).contains(&Predictor::PressureLoop),
         &cogging_orders,
     );
     // The free-payload pressure replay, only when the piston moves: the baseline of the
@@ -269,6 +319,10 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         } else {
             BTreeMap::new()
         };
+    let hold_from = hold_scored_from(log).map_or(from, |k| k.max(from));
+    let hold_rows = t
+        .partition_point(|x| *x < t[hold_from.min(n - 1)] + MAX_HOLD_IDENTIFICATION_S)
+        .min(split);
     let targets: BTreeMap<Predictor, Target> = predictors(log)
         .into_iter()
         .map(|p| {
@@ -279,13 +333,21 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
                     .iter()
                     .filter_map(|s| Some((*s, base_pred.inner_loops.get(s)?.clone())))
                     .collect()
+            } else if p == Predictor::PressureLoop {
+                predict(log, rig, p, hold_rows, 0.0).unwrap_or_default()
             } else {
                 p.signals()
                     .iter()
                     .filter_map(|s| Some((*s, baseline.get(s)?.clone())))
                     .collect()
             };
-            (p, Target::new(log, rig, split, from, &pred))
+            // The hold replay predicts the settled hold only, and is fitted on its first
+            // second at most.
+            let (from, rows) = match p {
+                Predictor::PressureLoop => (hold_from, hold_rows),
+                _ => (from, split),
+            };
+            (p, Target::new(log, rig, rows, from, &pred))
         })
         .filter(|(_, t)| !t.baseline_sse.is_empty())
         .collect();

@@ -29,7 +29,7 @@ pub const TOLERANCE_LIMIT: f64 = 2.5;
 pub fn tolerance_dims(p: Predictor) -> usize {
     match p {
         Predictor::Hydraulics | Predictor::Cylinder => 2,
-        Predictor::Motor | Predictor::ClosedLoop => 1,
+        Predictor::Motor | Predictor::ClosedLoop | Predictor::PressureLoop => 1,
         Predictor::Electrical => 0,
     }
 }
@@ -93,6 +93,8 @@ impl Candidate {
                 rig.absorber.shell_volume_m3 *= k1;
             }
             Predictor::Motor | Predictor::ClosedLoop => rig.motor.psi_f_wb *= k0,
+            // The pump speed that replaces a flow scales with 1/displacement.
+            Predictor::PressureLoop => rig.pump.displacement_m3_per_rev *= k0,
             Predictor::Electrical => {}
         }
         self.effect(u, nominal).apply(&mut rig);
@@ -274,12 +276,14 @@ fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 /// Every candidate the log can show, given which predictors it supports and the orders the
 /// residual spectrum points at (`cogging_orders`; the rig's slot/pole order when empty).
 /// `closed_loop`: the log's setpoints can be replayed, so the angle-locked torque effects
-/// are fitted on the closed loop, else on the motor replay.
+/// are fitted on the closed loop, else on the motor replay. `pressure_loop`: the log is in
+/// pressure control, so the leakage is fitted on the pump speed of the whole loop too.
 pub fn candidates(
     rig: &Rig,
     has_angle: bool,
     piston_moves: bool,
     closed_loop: bool,
+    pressure_loop: bool,
     cogging_orders: &[u32],
 ) -> Vec<Candidate> {
     let ripple = if closed_loop {
@@ -342,6 +346,20 @@ pub fn candidates(
             2,
         ),
     ];
+    if pressure_loop {
+        out.push(one(
+            "none",
+            Predictor::PressureLoop,
+            log_grid(-2.0, 2.0, 5),
+            0,
+        ));
+        out.push(one(
+            "extra_leakage",
+            Predictor::PressureLoop,
+            log_grid(-3.0, 3.0, 7),
+            1,
+        ));
+    }
     if piston_moves {
         out.push(one("none", Predictor::Cylinder, log_grid(-2.0, 2.0, 5), 0));
         // ln(F_c/300 N): 25 N to 5 kN.

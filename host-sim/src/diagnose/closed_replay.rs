@@ -8,7 +8,9 @@
 //! The plant's sensors are noise-free here: the replay predicts the expected signals, and
 //! the log's own noise is what the residual then shows.
 //!
-//! When the log has the shaft angle, a kinematic phase lock keeps the simulated shaft near
+//! When the log has the shaft angle, the inner-loop replay ([`Reference::SpeedReference`];
+//! the whole loop runs free, its shaft speed being what it predicts) has a kinematic phase
+//! lock keep the simulated shaft near
 //! the logged angle: every period the simulated angle is moved by a fraction of its error,
 //! a first-order pull with bandwidth [`ANGLE_LOCK_RAD_S`], its speed and every other state
 //! left alone. Without it the simulated shaft drifts from the logged one by a few percent
@@ -209,6 +211,10 @@ pub fn replay_closed_loop_rows(
         id_a: Vec::with_capacity(n),
     };
     let t0 = log.t_s[0];
+    // Only the inner loops are locked: the whole loop's shaft speed is what it predicts
+    // (the pump speed that holds the pressure against the leakage), which a pull to the
+    // logged angle would impose instead.
+    let locked = reference == Reference::SpeedReference;
     let pull = ANGLE_LOCK_RAD_S * cl.period_s();
     let mut row = 0;
     let mut last = cl.step();
@@ -236,8 +242,10 @@ pub fn replay_closed_loop_rows(
                 let f = (now - log.t_s[row]) / (log.t_s[row + 1] - log.t_s[row]);
                 let reference = th[row] + (th[row + 1] - th[row]) * f.clamp(0.0, 1.0);
                 // The simulated shaft starts at angle 0, the logged one at th[0].
-                let e = reference - th[0] - cl.plant().shaft_angle_rad();
-                cl.shift_shaft_angle(pull * e);
+                if locked {
+                    let e = reference - th[0] - cl.plant().shaft_angle_rad();
+                    cl.shift_shaft_angle(pull * e);
+                }
                 if let Some(m) = &injected {
                     cl.set_external_torque_nm(m.cogging_torque_nm(reference));
                 }
@@ -251,4 +259,121 @@ pub fn replay_closed_loop_rows(
         out.id_a.push(f.id_a as f64);
     }
     Some(out)
+}
+
+/// Pressure error, relative to the setpoint, within which the log holds its setpoint: the
+/// fill's overshoot has died out to a few times the transducer's noise (10 kPa at 5 MPa,
+/// against the mean's noise of 0.3 kPa over [`HOLD_MEAN_ROWS`]). [1]
+pub const HOLD_BAND: f64 = 0.002;
+
+/// Rows of the centred mean the hold test applies to the logged pressure (the transducer's
+/// noise would otherwise break the band). [1]
+pub const HOLD_MEAN_ROWS: usize = 21;
+
+/// Time after which a hold no longer shows how it began: the whole loop settles from a
+/// cold start at the held pressure in 0.1–0.2 s (the speed loop's integral builds the
+/// holding torque, the pressure loop's the leakage speed; the suite's holding logs), and
+/// the real loop's recovery from the fill's overshoot takes as long. [s]
+pub const HOLD_SETTLING_S: f64 = 0.3;
+
+/// First row of the pressure hold the log ends in: after it the logged pressure (its mean
+/// over [`HOLD_MEAN_ROWS`]) stays within [`HOLD_BAND`] of a positive setpoint; `None`
+/// without pressure control or when the log does not end holding.
+pub fn final_hold_start(log: &BenchLog) -> Option<usize> {
+    let n = log.len();
+    let half = HOLD_MEAN_ROWS / 2;
+    if n <= 2 * half {
+        return None;
+    }
+    let width = 2 * half + 1;
+    // holding[j]: row j + half, the centre of window j, holds.
+    let holding: Vec<bool> = log
+        .p_pa
+        .windows(width)
+        .zip(&log.p_ref_pa[half..])
+        .map(|(w, &r)| {
+            let mean = w.iter().sum::<f64>() / width as f64;
+            r > 0.0 && (mean - r).abs() <= HOLD_BAND * r
+        })
+        .collect();
+    if !holding.last().copied().unwrap_or(false) {
+        return None;
+    }
+    let first = holding.iter().rposition(|h| !h).map_or(0, |j| j + 1);
+    Some(first + half)
+}
+
+/// The pump speed of the whole loop holding the log's final pressure hold, replayed from
+/// that hold's first row (its logged pressure, the controller cold): the rows before are
+/// the logged speed, unscored (see [`hold_scored_from`]). In a hold the pump turns just fast
+/// enough to replace the leakage, whatever happened before; a replay through the fill
+/// before it would carry the fill's timing error (a few percent of its length, from the
+/// absorber's tolerances) into a hold that, in the replay, has not begun yet. `None`
+/// without a final pressure hold.
+pub fn replay_pressure_hold(log: &BenchLog, rig: &Rig, rows: usize) -> Option<Vec<f64>> {
+    let k0 = final_hold_start(log)?;
+    let rows = rows.min(log.len());
+    let mut speed = log.speed_rad_s[..k0.min(rows)].to_vec();
+    if rows > k0 {
+        let tail = log.tail(k0);
+        let r = replay_closed_loop_rows(&tail, rig, rows - k0, Reference::Setpoints)?;
+        speed.extend(r.speed_rad_s);
+    }
+    Some(speed)
+}
+
+/// First row a hold replay ([`replay_pressure_hold`]) predicts: [`HOLD_SETTLING_S`] into
+/// the final hold.
+pub fn hold_scored_from(log: &BenchLog) -> Option<usize> {
+    let k0 = final_hold_start(log)?;
+    let t = log.t_s[k0] + HOLD_SETTLING_S;
+    Some(log.t_s.partition_point(|x| *x < t))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 1 kHz pressure-control log at setpoint 5 MPa whose pressure is `low` before row
+    /// `step` and exactly the setpoint from it on.
+    fn stepped(n: usize, step: usize, low: f64) -> BenchLog {
+        BenchLog {
+            t_s: (0..n).map(|k| k as f64 * 1e-3).collect(),
+            p_ref_pa: vec![5e6; n],
+            p_pa: (0..n).map(|k| if k < step { low } else { 5e6 }).collect(),
+            speed_rad_s: vec![0.0; n],
+            iq_a: vec![0.0; n],
+            id_a: vec![0.0; n],
+            ..BenchLog::default()
+        }
+    }
+
+    #[test]
+    fn the_final_hold_starts_where_the_mean_pressure_enters_the_band() {
+        // 100 kPa below the setpoint until row 400: a 21-row mean is within 0.2 % (10 kPa)
+        // once at most 2 of its rows are low (2·100/21 = 9.5 kPa, 3 rows 14.3 kPa), i.e.
+        // from the window starting at row 398, centred on row 408.
+        let log = stepped(1000, 400, 4.9e6);
+        assert_eq!(final_hold_start(&log), Some(408));
+        // Scored 0.3 s later.
+        assert_eq!(hold_scored_from(&log), Some(708));
+        // A log that ends 100 kPa off its setpoint is not holding.
+        let log = stepped(1000, 2000, 4.9e6);
+        assert_eq!(final_hold_start(&log), None);
+        // Without a pressure setpoint there is no hold.
+        let mut log = stepped(1000, 400, 4.9e6);
+        log.p_ref_pa = vec![0.0; 1000];
+        assert_eq!(final_hold_start(&log), None);
+    }
+
+    #[test]
+    fn a_tail_restarts_its_time_and_keeps_its_rows() {
+        let log = stepped(1000, 400, 4.9e6);
+        let tail = log.tail(400);
+        assert_eq!(tail.len(), 600);
+        assert_eq!(tail.t_s[0], 0.0);
+        assert!((tail.t_s[599] - 0.599).abs() < 1e-12);
+        assert!(tail.p_pa.iter().all(|p| *p == 5e6));
+        assert!(tail.theta_m_rad.is_none());
+    }
 }

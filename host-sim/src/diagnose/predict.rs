@@ -22,9 +22,16 @@
 //!   to it is what the log shows, and only the loop itself predicts that answer's amplitude
 //!   and phase; the motor replay, driven by the logged current sampled at 1 kHz, sees a
 //!   65 Hz ripple with a timing error of a fraction of a sample, i.e. tenths of a radian.
+//! - [`Predictor::PressureLoop`] ([`super::closed_replay::replay_pressure_hold`]): the pump
+//!   speed of the whole loop holding the log's final pressure hold, replayed from that
+//!   hold's start (pressure control only). In a hold the pump turns just fast enough to
+//!   replace the leakage, so the speed the pressure loop settles at measures the leakage
+//!   directly; the hydraulic replay sees the same leakage only through a pressure drift
+//!   over the absorber's compliance, a time constant of tens of seconds, and in a fill only
+//!   as a few percent of the flow, which the rig's tolerances mimic.
 //! - [`Predictor::Electrical`] ([`super::electrical`]): the commanded `ud_v`, `uq_v`.
 
-use super::closed_replay::{replay_closed_loop_rows, Reference};
+use super::closed_replay::{replay_closed_loop_rows, replay_pressure_hold, Reference};
 use super::electrical::replay_electrical;
 use super::replay::{replay_with, ReplayError, ReplayKind, ReplayOptions};
 use crate::bench_log::BenchLog;
@@ -47,6 +54,8 @@ pub enum Predictor {
     Electrical,
     /// Speed and current of the speed and current loops from the logged speed reference.
     ClosedLoop,
+    /// Pump speed of the whole loop holding the log's final pressure hold.
+    PressureLoop,
 }
 
 impl Predictor {
@@ -55,6 +64,7 @@ impl Predictor {
         match self {
             Predictor::Hydraulics | Predictor::Cylinder => &["p_pa"],
             Predictor::Motor | Predictor::ClosedLoop => &["speed_rad_s", "iq_a"],
+            Predictor::PressureLoop => &["speed_rad_s"],
             Predictor::Electrical => &["ud_v", "uq_v"],
         }
     }
@@ -68,6 +78,7 @@ impl Predictor {
             Predictor::Cylinder => "hydraulics driven by the logged shaft angle, payload simulated",
             Predictor::Motor => "motor and shaft driven by the logged currents",
             Predictor::Electrical => "stator voltages from the logged currents and speed",
+            Predictor::PressureLoop => "the whole loop replayed over the final pressure hold",
             Predictor::ClosedLoop => {
                 "speed and current loops replayed on the logged speed reference"
             }
@@ -124,6 +135,10 @@ pub fn predict(
                 None => Vec::new(),
             }
         }
+        Predictor::PressureLoop => match replay_pressure_hold(log, rig, rows) {
+            Some(speed) => vec![("speed_rad_s", speed)],
+            None => Vec::new(),
+        },
         Predictor::Electrical => match replay_electrical(log, rig, rows) {
             Some(e) => vec![("ud_v", e.ud_v), ("uq_v", e.uq_v)],
             None => Vec::new(),
