@@ -317,11 +317,13 @@ pub fn candidates(
             log_grid(-3.0, 3.0, 7),
             1,
         ),
-        // ln(β_nom/β − 1): β from 95 % down to 5 % of nominal.
+        // ln(β_nom/β − 1): β from 95 % down to 5 % of nominal. Half-unit steps: the cost
+        // valley between the bulk modulus and the displacement tolerance is narrow and
+        // curved, and a whole-unit grid left the simplex in it tens of percent off.
         one(
             "entrained_air",
             Predictor::Hydraulics,
-            log_grid(-3.0, 3.0, 7),
+            log_grid(-3.0, 3.0, 13),
             1,
         ),
         // ln(p0/p0_nom): a fifth to five times nominal.
