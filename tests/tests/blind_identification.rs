@@ -186,8 +186,8 @@ fn show_fit(f: Option<f64>) -> String {
 }
 
 #[test]
-#[ignore = "issue 5 is open: the diagnosis passes 32 of the 36 seeds (not yet entrained air \
-            in seed 24, nor piston ripple, which stays at the sensors' floor); run \
+#[ignore = "issue 5 is open: the diagnosis passes 33 of the 36 seeds (not yet piston \
+            ripple, which stays at the sensors' floor); run \
             with `cargo test -p tests --test blind_identification -- --ignored --nocapture` \
             for the table"]
 fn the_diagnosis_finds_every_hidden_effect() {

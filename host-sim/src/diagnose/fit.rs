@@ -7,7 +7,7 @@
 //! rows: each signal's squared error over the nominal model's, their geometric mean over
 //! the signals: 1 is "explains nothing", 0 "explains everything".
 
-use super::candidates::{grid_is_phase, Candidate};
+use super::candidates::{grid_is_phase, tolerance_dims, Candidate};
 use super::predict::{predict, Predicted};
 use crate::bench_log::BenchLog;
 use argmin::core::{CostFunction, Error, Executor, State};
@@ -177,8 +177,21 @@ pub fn fit(target: &Target<'_>, c: &Candidate) -> CandidateFit {
     };
     let mut best = (c.start.clone(), f64::MAX);
     let phase_grid = grid_is_phase(c);
+    let dims = c.start.len();
+    let tolerance_at = dims.saturating_sub(tolerance_dims(c.predictor));
+    let tolerance_starts: Vec<Vec<f64>> = c
+        .tolerance_grid
+        .iter()
+        .filter(|_| tolerance_at < dims)
+        .map(|v| {
+            let mut u = c.start.clone();
+            u[tolerance_at] = *v;
+            u
+        })
+        .collect();
     let starts = std::iter::once(&c.start)
-        .chain(Some(&c.alternative_start).filter(|s| s.len() == c.start.len()));
+        .chain(Some(&c.alternative_start).filter(|s| s.len() == dims))
+        .chain(&tolerance_starts);
     for start in starts {
         for g in &c.grid {
             let mut u = start.clone();
