@@ -5,12 +5,10 @@
 //! minimum lies
 //! (`cargo run --release -p host-sim --example cost_probe -- LOG.csv EFFECT[/PREDICTOR] [--coord K] [U1 …]`).
 
-use closed_loop::ScenarioKind;
-use host_sim::diagnose::analysis::segments;
+use host_sim::diagnose::analysis::{predictors, scored_rows, segments};
 use host_sim::diagnose::candidates::{candidates, grid_is_phase};
-use host_sim::diagnose::closed_replay::scenario_of;
 use host_sim::diagnose::fit::Target;
-use host_sim::diagnose::predict::{piston_moves, predict};
+use host_sim::diagnose::predict::predict;
 use plant_model::Rig;
 use std::path::PathBuf;
 
@@ -35,14 +33,10 @@ fn main() {
     let given: Vec<f64> = rest.iter().map(|a| a.parse().expect("a number")).collect();
     let log = host_sim::bench_log::read(&path).expect("a valid bench log");
     let rig = Rig::nominal();
-    let closed_loop = log.theta_m_rad.is_some() && scenario_of(&log).is_some();
-    let pressure_loop = scenario_of(&log).is_some_and(|s| s.kind == ScenarioKind::PressureStep);
     let cands = candidates(
         &rig,
+        &predictors(&log),
         log.theta_m_rad.is_some(),
-        piston_moves(&log),
-        closed_loop,
-        pressure_loop,
         &[rig.motor.cogging_fundamental_order()],
     );
     let c = cands
@@ -55,8 +49,9 @@ fn main() {
         })
         .expect("a candidate of that name");
     let (split, from) = segments(&log);
-    let base = predict(&log, &rig, c.predictor, usize::MAX, 0.0).expect("replay");
-    let target = Target::new(&log, &rig, split, from, &base);
+    let (from, rows) = scored_rows(&log, c.predictor, split, from);
+    let base = predict(&log, &rig, c.predictor, rows, 0.0).expect("replay");
+    let target = Target::new(&log, &rig, rows, from, &base);
     println!("baseline sse {:?}", target.baseline_sse);
     let mut u = c.start.clone();
     for (k, v) in given.iter().enumerate().take(u.len()) {
@@ -72,7 +67,7 @@ fn main() {
     for g in sweep {
         u[coord] = g;
         let r = c.rig_at(&u, &rig);
-        let p = predict(&log, &r, c.predictor, split, c.phase_a_offset_a(&u)).expect("replay");
+        let p = predict(&log, &r, c.predictor, rows, c.phase_a_offset_a(&u)).expect("replay");
         println!(
             "u{coord} {g:+.2} {:?} cost {:.4} sse {:?}",
             c.parameters(&u, &rig),

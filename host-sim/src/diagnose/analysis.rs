@@ -47,8 +47,8 @@ pub const MIN_VALIDATION_GAIN_POINTS: f64 = 1.0;
 /// that time). [1]
 const MIN_HOLD_ROWS: usize = 100;
 
-/// Longest settled hold the hold replay is fitted on: its pump speed is a level, which a
-/// second of a hold fixes to the speed noise over √1000 (each evaluation replays the whole
+/// Longest settled hold the hold replay is fitted on: its pump speed is a level, which half
+/// a second of a hold fixes to the speed noise over √500 (each evaluation replays the whole
 /// loop, the costliest of the replays). [s]
 const MAX_HOLD_IDENTIFICATION_S: f64 = 0.5;
 
@@ -83,7 +83,7 @@ fn column<'a>(log: &'a BenchLog, name: &str) -> Option<&'a [f64]> {
 }
 
 /// The predictors the log supports.
-fn predictors(log: &BenchLog) -> Vec<Predictor> {
+pub fn predictors(log: &BenchLog) -> Vec<Predictor> {
     let mut p = vec![Predictor::Hydraulics, Predictor::Motor];
     if piston_moves(log) {
         p.push(Predictor::Cylinder);
@@ -92,7 +92,7 @@ fn predictors(log: &BenchLog) -> Vec<Predictor> {
         p.push(Predictor::Electrical);
     }
     if log.theta_m_rad.is_some() && scenario_of(log).is_some() {
-        p.push(Predictor::ClosedLoop);
+        p.push(Predictor::InnerLoops);
     }
     // A log that holds from the start has its leakage in the hydraulic replay's pressure
     // drift over the identification segment; one whose final hold begins after the
@@ -113,7 +113,7 @@ pub struct Predictions {
     /// Hydraulic, motor and electrical replays by signal.
     pub subsystem: BTreeMap<&'static str, Vec<f64>>,
     /// Speed and current loops replayed on the logged speed reference
-    /// ([`Predictor::ClosedLoop`]) by signal; empty without the shaft angle.
+    /// ([`Predictor::InnerLoops`]) by signal; empty without the shaft angle.
     pub inner_loops: BTreeMap<&'static str, Vec<f64>>,
     /// The whole closed loop replayed from the logged setpoints, by signal (empty when the
     /// log has no usable setpoint).
@@ -148,6 +148,7 @@ impl Predictions {
 /// piston prescribed, or with it simulated when the extension is the cylinder's).
 fn predict_all(
     log: &BenchLog,
+    supported: &[Predictor],
     rig: &Rig,
     phase_a_offset_a: f64,
     pressure: Predictor,
@@ -155,8 +156,9 @@ fn predict_all(
     // The whole loop's replay (every signal it predicts) beside the others.
     let (preds, whole): (Vec<Result<(Predictor, Predicted), ReplayError>>, _) = rayon::join(
         || {
-            predictors(log)
-                .into_par_iter()
+            supported
+                .par_iter()
+                .copied()
                 .filter(|p| match p {
                     Predictor::Hydraulics | Predictor::Cylinder => *p == pressure,
                     Predictor::PressureLoop => false,
@@ -171,7 +173,7 @@ fn predict_all(
     for p in preds {
         let (predictor, predicted) = p?;
         let map = match predictor {
-            Predictor::ClosedLoop => &mut out.inner_loops,
+            Predictor::InnerLoops => &mut out.inner_loops,
             _ => &mut out.subsystem,
         };
         map.extend(predicted);
@@ -233,9 +235,9 @@ fn fit_of(
 /// The split is the log's middle (at most [`MAX_IDENTIFICATION_S`] in), unless the log
 /// ends in a pressure hold the first half does not reach: a pressure step whose fill takes
 /// most of the log. Then the identification segment runs half-way into that hold's settled
-/// part ([`hold_scored_from`]), so the fit sees the regime the validation tests — the hold is where the leakage shows in
-/// the pump speed that replaces it, while in the fill it is a few percent of the pump's
-/// flow, where the rig's tolerances would mimic it.
+/// part ([`hold_scored_from`]), so the fit sees the regime the validation tests: the hold is
+/// where the leakage shows, in the pump speed that replaces it, while in the fill it is a
+/// few percent of the pump's flow, where the rig's tolerances would mimic it.
 pub fn segments(log: &BenchLog) -> (usize, usize) {
     let n = log.len();
     let t = &log.t_s;
@@ -247,6 +249,27 @@ pub fn segments(log: &BenchLog) -> (usize, usize) {
     }
     let split = t.partition_point(|x| *x < t_split).clamp(2, n - 1);
     (split, INITIAL_SAMPLES.min(split / 4))
+}
+
+/// The identification rows `predictor` is fitted on, as (first scored row, end row), for a
+/// log whose identification segment is `from..split` ([`segments`]): those, except for the
+/// hold replay, which predicts the settled final hold only and is fitted on at most
+/// [`MAX_HOLD_IDENTIFICATION_S`] of it.
+pub fn scored_rows(
+    log: &BenchLog,
+    predictor: Predictor,
+    split: usize,
+    from: usize,
+) -> (usize, usize) {
+    if predictor != Predictor::PressureLoop {
+        return (from, split);
+    }
+    let t = &log.t_s;
+    let first = hold_scored_from(log).map_or(from, |k| k.max(from));
+    let end = t
+        .partition_point(|x| *x < t[first.min(t.len() - 1)] + MAX_HOLD_IDENTIFICATION_S)
+        .min(split);
+    (first, end)
 }
 
 /// The identification segment's end without a late final hold: the log's middle, at most
@@ -267,7 +290,8 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     // 1. Segments.
     let (split, from) = segments(log);
     // 2. Baseline.
-    let mut base_pred = predict_all(log, rig, 0.0, Predictor::Hydraulics)?;
+    let supported = predictors(log);
+    let mut base_pred = predict_all(log, &supported, rig, 0.0, Predictor::Hydraulics)?;
     let baseline = base_pred.subsystem.clone();
     let measured: BTreeMap<&'static str, Vec<f64>> = base_pred
         .contract()
@@ -301,52 +325,37 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         }
     }
     // 4. Candidates fitted on the identification rows.
-    let cands = candidates(
-        rig,
-        theta.is_some(),
-        piston_moves(log),
-        predictors(log).contains(&Predictor::ClosedLoop),
-        predictors(log).contains(&Predictor::PressureLoop),
-        &cogging_orders,
-    );
+    let cands = candidates(rig, &supported, theta.is_some(), &cogging_orders);
     // The free-payload pressure replay, only when the piston moves: the baseline of the
     // cylinder's candidates, and the contract's baseline pressure if one of them is kept.
     let cylinder_baseline: BTreeMap<&'static str, Vec<f64>> =
-        if predictors(log).contains(&Predictor::Cylinder) {
+        if supported.contains(&Predictor::Cylinder) {
             predict(log, rig, Predictor::Cylinder, usize::MAX, 0.0)?
                 .into_iter()
                 .collect()
         } else {
             BTreeMap::new()
         };
-    let hold_from = hold_scored_from(log).map_or(from, |k| k.max(from));
-    let hold_rows = t
-        .partition_point(|x| *x < t[hold_from.min(n - 1)] + MAX_HOLD_IDENTIFICATION_S)
-        .min(split);
-    let targets: BTreeMap<Predictor, Target> = predictors(log)
-        .into_iter()
+    let targets: BTreeMap<Predictor, Target> = supported
+        .iter()
+        .copied()
         .map(|p| {
             let pred: Predicted = if p == Predictor::Cylinder {
                 cylinder_baseline.clone().into_iter().collect()
-            } else if p == Predictor::ClosedLoop {
+            } else if p == Predictor::InnerLoops {
                 p.signals()
                     .iter()
                     .filter_map(|s| Some((*s, base_pred.inner_loops.get(s)?.clone())))
                     .collect()
             } else if p == Predictor::PressureLoop {
-                predict(log, rig, p, hold_rows, 0.0).unwrap_or_default()
+                predict(log, rig, p, scored_rows(log, p, split, from).1, 0.0).unwrap_or_default()
             } else {
                 p.signals()
                     .iter()
                     .filter_map(|s| Some((*s, baseline.get(s)?.clone())))
                     .collect()
             };
-            // The hold replay predicts the settled hold only, and is fitted on its first
-            // second at most.
-            let (from, rows) = match p {
-                Predictor::PressureLoop => (hold_from, hold_rows),
-                _ => (from, split),
-            };
+            let (from, rows) = scored_rows(log, p, split, from);
             (p, Target::new(log, rig, rows, from, &pred))
         })
         .filter(|(_, t)| !t.baseline_sse.is_empty())
@@ -458,7 +467,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
                 // Baseline and extension on the same replay, so the gain is the extension's.
                 base_pred.subsystem.extend(cylinder_baseline.clone());
             }
-            kept = Some((i, predict_all(log, &ext_rig, offset, pressure)?));
+            kept = Some((i, predict_all(log, &supported, &ext_rig, offset, pressure)?));
             break;
         }
         notes.insert(

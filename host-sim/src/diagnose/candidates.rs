@@ -29,7 +29,7 @@ pub const TOLERANCE_LIMIT: f64 = 2.5;
 pub fn tolerance_dims(p: Predictor) -> usize {
     match p {
         Predictor::Hydraulics | Predictor::Cylinder => 2,
-        Predictor::Motor | Predictor::ClosedLoop | Predictor::PressureLoop => 1,
+        Predictor::Motor | Predictor::InnerLoops | Predictor::PressureLoop => 1,
         Predictor::Electrical => 0,
     }
 }
@@ -96,7 +96,7 @@ impl Candidate {
                 rig.pump.displacement_m3_per_rev *= k0;
                 rig.absorber.shell_volume_m3 *= k1;
             }
-            Predictor::Motor | Predictor::ClosedLoop => rig.motor.psi_f_wb *= k0,
+            Predictor::Motor | Predictor::InnerLoops => rig.motor.psi_f_wb *= k0,
             // The pump speed that replaces a flow scales with 1/displacement.
             Predictor::PressureLoop => rig.pump.displacement_m3_per_rev *= k0,
             Predictor::Electrical => {}
@@ -277,21 +277,21 @@ fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Every candidate the log can show, given which predictors it supports and the orders the
-/// residual spectrum points at (`cogging_orders`; the rig's slot/pole order when empty).
-/// `closed_loop`: the log's setpoints can be replayed, so the angle-locked torque effects
-/// are fitted on the closed loop, else on the motor replay. `pressure_loop`: the log is in
-/// pressure control, so the leakage is fitted on the pump speed of the whole loop too.
+/// Every candidate the log can show, given the predictors it supports (`predictors`),
+/// whether it logs the shaft angle, and the orders the residual spectrum points at
+/// (`cogging_orders`; the rig's slot/pole order when empty). Every predictor with tolerance
+/// coordinates gets its `none`, the nominal model within those tolerances; the angle-locked
+/// torque effects are fitted on the inner loops when they can be replayed, else on the
+/// motor replay.
 pub fn candidates(
     rig: &Rig,
+    predictors: &[Predictor],
     has_angle: bool,
-    piston_moves: bool,
-    closed_loop: bool,
-    pressure_loop: bool,
     cogging_orders: &[u32],
 ) -> Vec<Candidate> {
-    let ripple = if closed_loop {
-        Predictor::ClosedLoop
+    let supports = |p: Predictor| predictors.contains(&p);
+    let ripple = if supports(Predictor::InnerLoops) {
+        Predictor::InnerLoops
     } else {
         Predictor::Motor
     };
@@ -310,11 +310,14 @@ pub fn candidates(
             tolerance_grid: Vec::new(),
         }
     };
-    let mut out = vec![
-        // The nominal model within its tolerances, per predictor (tolerance coordinate
-        // only; its grid runs over it).
-        one("none", Predictor::Hydraulics, log_grid(-2.0, 2.0, 5), 0),
-        one("none", Predictor::Motor, log_grid(-2.0, 2.0, 5), 0),
+    // The nominal model within its tolerances, per predictor (tolerance coordinates only;
+    // its grid runs over the first).
+    let mut out: Vec<Candidate> = predictors
+        .iter()
+        .filter(|p| tolerance_dims(**p) > 0)
+        .map(|p| one("none", *p, log_grid(-2.0, 2.0, 5), 0))
+        .collect();
+    out.extend([
         // Search units: ln(coefficient / nominal leakage), from 1/20 to 20 times nominal.
         one(
             "extra_leakage",
@@ -357,14 +360,8 @@ pub fn candidates(
             log_grid(-2.5, 2.5, 6),
             2,
         ),
-    ];
-    if pressure_loop {
-        out.push(one(
-            "none",
-            Predictor::PressureLoop,
-            log_grid(-2.0, 2.0, 5),
-            0,
-        ));
+    ]);
+    if supports(Predictor::PressureLoop) {
         out.push(one(
             "extra_leakage",
             Predictor::PressureLoop,
@@ -372,8 +369,7 @@ pub fn candidates(
             1,
         ));
     }
-    if piston_moves {
-        out.push(one("none", Predictor::Cylinder, log_grid(-2.0, 2.0, 5), 0));
+    if supports(Predictor::Cylinder) {
         // ln(F_c/300 N): 25 N to 5 kN.
         out.push(one(
             "cylinder_friction",
@@ -383,14 +379,6 @@ pub fn candidates(
         ));
     }
     if has_angle {
-        if closed_loop {
-            out.push(one(
-                "none",
-                Predictor::ClosedLoop,
-                log_grid(-2.0, 2.0, 5),
-                0,
-            ));
-        }
         out.push(one(
             "dead_time",
             Predictor::Electrical,

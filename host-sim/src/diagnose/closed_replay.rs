@@ -124,16 +124,27 @@ pub fn scenario_of(log: &BenchLog) -> Option<Scenario> {
             last = v;
         }
     }
-    Some(Scenario {
+    Some(log_scenario(log, "the log's setpoints", kind, events))
+}
+
+/// A replay scenario of `log` with `events`: piston blocked unless the log shows it
+/// moving, the logged initial pressure, the log's length.
+fn log_scenario(
+    log: &BenchLog,
+    description: &'static str,
+    kind: ScenarioKind,
+    events: [Option<(f64, Command)>; MAX_EVENTS],
+) -> Scenario {
+    Scenario {
         name: "log replay",
-        description: "the log's setpoints",
+        description,
         kind,
         blocked: !piston_moves(log),
         initial_pressure_pa: log.p_pa[0],
         duration_s: log.t_s[log.len() - 1],
         steady_from_s: 0.0,
         events,
-    })
+    }
 }
 
 /// Replays the closed loop of `log` on `rig`; `None` when the log has no usable setpoint or
@@ -163,16 +174,12 @@ fn speed_reference_scenario(log: &BenchLog, speed_ref: &[f64]) -> Scenario {
         },
     ));
     events[1] = Some((0.0, Command::SetMode(Mode::Speed)));
-    Scenario {
-        name: "log replay",
-        description: "the log's speed reference",
-        kind: ScenarioKind::SpeedStep,
-        blocked: !piston_moves(log),
-        initial_pressure_pa: log.p_pa[0],
-        duration_s: log.t_s[log.len() - 1],
-        steady_from_s: 0.0,
+    log_scenario(
+        log,
+        "the log's speed reference",
+        ScenarioKind::SpeedStep,
         events,
-    }
+    )
 }
 
 /// [`replay_closed_loop`] over the first `rows` rows only (an identification segment),
@@ -191,7 +198,13 @@ pub fn replay_closed_loop_rows(
         Some(w) => speed_reference_scenario(log, w),
         None => scenario_of(log)?,
     };
-    let theta = log.theta_m_rad.as_deref().map(super::replay::unwrap_angle);
+    let n = log.len();
+    // The rows replayed and the one after (the angle is interpolated towards it).
+    let used = rows.saturating_add(1).min(n);
+    let theta = log
+        .theta_m_rad
+        .as_deref()
+        .map(|th| super::replay::unwrap_angle(&th[..used]));
     let injected = theta.as_ref().and(cogging_of(rig));
     let mut quiet = match injected {
         Some(_) => without_cogging(rig),
@@ -203,7 +216,6 @@ pub fn replay_closed_loop_rows(
     let config = controller_config(rig);
     let speed_limit = config.speed.speed_limit_rad_s;
     let mut cl = ClosedLoop::new(&quiet, &config, &scenario, 0).ok()?;
-    let n = log.len();
     let mut out = ClosedLoopReplay {
         p_pa: Vec::with_capacity(n),
         speed_rad_s: Vec::with_capacity(n),
@@ -216,31 +228,28 @@ pub fn replay_closed_loop_rows(
     // logged angle would impose instead.
     let locked = reference == Reference::SpeedReference;
     let pull = ANGLE_LOCK_RAD_S * cl.period_s();
+    // The logged interval [row, row + 1] holding the period about to run.
     let mut row = 0;
     let mut last = cl.step();
-    let mut next_row = 0;
-    for &t in &log.t_s[..rows.min(log.len())] {
+    for &t in &log.t_s[..rows.min(n)] {
         // Each row takes the telemetry of the period whose sample instant is nearest.
         while cl.time_s() + 0.5 * cl.period_s() <= t - t0 {
+            let now = cl.time_s() + t0;
+            while row + 2 < used && log.t_s[row + 1] <= now {
+                row += 1;
+            }
+            let f = ((now - log.t_s[row]) / (log.t_s[row + 1] - log.t_s[row])).clamp(0.0, 1.0);
             if let Some(w) = speed_ref {
-                // The pressure loop's output the row after this instant logged: the value
-                // the real speed loop was following by then.
-                let now = cl.time_s() + t0;
-                while next_row + 1 < log.len() && log.t_s[next_row] < now {
-                    next_row += 1;
-                }
-                let rad_s = (w[next_row] as f32).clamp(-speed_limit, speed_limit);
+                // The pressure loop's output the first row at or after this instant logged:
+                // the value the real speed loop was following by then.
+                let next = if f > 0.0 { row + 1 } else { row };
+                let rad_s = (w[next] as f32).clamp(-speed_limit, speed_limit);
                 // In range by the clamp, so the controller accepts it.
                 let _ = cl.command(Command::SetSpeed { rad_s });
             }
             if let Some(th) = &theta {
                 // The logged angle at this instant (linear between rows).
-                let now = cl.time_s() + t0;
-                while row + 2 < log.len() && log.t_s[row + 1] <= now {
-                    row += 1;
-                }
-                let f = (now - log.t_s[row]) / (log.t_s[row + 1] - log.t_s[row]);
-                let reference = th[row] + (th[row + 1] - th[row]) * f.clamp(0.0, 1.0);
+                let reference = th[row] + (th[row + 1] - th[row]) * f;
                 // The simulated shaft starts at angle 0, the logged one at th[0].
                 if locked {
                     let e = reference - th[0] - cl.plant().shaft_angle_rad();

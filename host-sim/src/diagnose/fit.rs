@@ -176,7 +176,8 @@ pub fn fit(target: &Target<'_>, c: &Candidate) -> CandidateFit {
         evaluations: &evaluations,
     };
     let mut best = (c.start.clone(), f64::MAX);
-    let phase_grid = grid_is_phase(c);
+    // The grid runs over the phase of a ripple, else over the first coordinate.
+    let axis = usize::from(grid_is_phase(c));
     let dims = c.start.len();
     let tolerance_at = dims.saturating_sub(tolerance_dims(c.predictor));
     let tolerance_starts: Vec<Vec<f64>> = c
@@ -195,13 +196,7 @@ pub fn fit(target: &Target<'_>, c: &Candidate) -> CandidateFit {
     for start in starts {
         for g in &c.grid {
             let mut u = start.clone();
-            if c.name == "none" {
-                u[0] = *g;
-            } else if phase_grid {
-                u[1] = *g;
-            } else {
-                u[0] = *g;
-            }
+            u[axis] = *g;
             let cost = problem.cost(&u).unwrap_or(f64::MAX);
             if cost < best.1 {
                 best = (u, cost);

@@ -14,7 +14,7 @@
 //!   it shows without that noise.
 //! - [`Predictor::Motor`]: the shaft speed `speed_rad_s` from the logged currents, and the
 //!   q current `iq_a` the model needed to follow the logged shaft motion.
-//! - [`Predictor::ClosedLoop`] ([`super::closed_replay`]): speed and q current of the
+//! - [`Predictor::InnerLoops`] ([`super::closed_replay`]): speed and q current of the
 //!   speed and current loops replayed on the logged speed reference (in pressure control,
 //!   the pressure loop's output), the shaft phase-locked to the logged angle and the
 //!   cogging torque applied at the logged angle. Angle-locked torque ripple (cogging, flux
@@ -53,7 +53,7 @@ pub enum Predictor {
     /// Commanded voltages from the currents and the speed.
     Electrical,
     /// Speed and current of the speed and current loops from the logged speed reference.
-    ClosedLoop,
+    InnerLoops,
     /// Pump speed of the whole loop holding the log's final pressure hold.
     PressureLoop,
 }
@@ -63,7 +63,7 @@ impl Predictor {
     pub fn signals(self) -> &'static [&'static str] {
         match self {
             Predictor::Hydraulics | Predictor::Cylinder => &["p_pa"],
-            Predictor::Motor | Predictor::ClosedLoop => &["speed_rad_s", "iq_a"],
+            Predictor::Motor | Predictor::InnerLoops => &["speed_rad_s", "iq_a"],
             Predictor::PressureLoop => &["speed_rad_s"],
             Predictor::Electrical => &["ud_v", "uq_v"],
         }
@@ -79,7 +79,7 @@ impl Predictor {
             Predictor::Motor => "motor and shaft driven by the logged currents",
             Predictor::Electrical => "stator voltages from the logged currents and speed",
             Predictor::PressureLoop => "the whole loop replayed over the final pressure hold",
-            Predictor::ClosedLoop => {
+            Predictor::InnerLoops => {
                 "speed and current loops replayed on the logged speed reference"
             }
         }
@@ -129,7 +129,7 @@ pub fn predict(
             let r = replay_with(log, rig, ReplayKind::Motor, &options)?;
             vec![("speed_rad_s", r.speed_rad_s), ("iq_a", r.iq_needed_a)]
         }
-        Predictor::ClosedLoop => {
+        Predictor::InnerLoops => {
             match replay_closed_loop_rows(log, rig, rows, Reference::SpeedReference) {
                 Some(c) => vec![("speed_rad_s", c.speed_rad_s), ("iq_a", c.iq_a)],
                 None => Vec::new(),
