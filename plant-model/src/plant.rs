@@ -487,6 +487,12 @@ impl Plant {
         self.x[ix::THETA]
     }
 
+    /// The port pressures (p_A, p_B), without evaluating the rest of the observables (a
+    /// replay applying the pump's torque ripple at a logged angle needs only these). [Pa]
+    pub fn port_pressures_pa(&self) -> (f64, f64) {
+        (self.x[ix::PA], self.x[ix::PB])
+    }
+
     /// Time since the start of the run. [s]
     pub fn time_s(&self) -> f64 {
         self.t_s

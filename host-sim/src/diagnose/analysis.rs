@@ -15,7 +15,7 @@
 //!    [`Candidate::is_significant`]) is kept only if it also improves its signals on the
 //!    validation segment; otherwise the answer is `none`.
 
-use super::candidates::{candidates, tolerance_dims, Candidate};
+use super::candidates::{candidates, tolerance_dims, Candidate, RIPPLE_PISTONS};
 use super::closed_replay::{hold_scored_from, replay_closed_loop, scenario_of};
 use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 use super::fit::{fit, CandidateFit, Target};
@@ -25,6 +25,7 @@ use super::spectrum::{order_spectrum, OrderSpectrum};
 use super::{fit_percent, DiagnoseError};
 use crate::bench_log::{BenchLog, Signal};
 use closed_loop::ScenarioKind;
+use plant_model::pump::ripple_order;
 use plant_model::Rig;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -314,18 +315,30 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     let pp = rig.motor.pole_pairs;
     let lcm = rig.motor.cogging_fundamental_order();
     let mut cogging_orders = vec![lcm];
+    let mut ripple_pistons = Vec::new();
     if let Some((_, s)) = spectra.iter().find(|(n, _)| *n == "speed_rad_s") {
-        // A strong line at an order the other angle-locked effects cannot make is a
-        // cogging order the rig file does not predict.
+        // A strong line at a pump's ripple order is its torque ripple (in a stroke, its
+        // flow ripple is fitted on the hydraulics whatever the spectrum); at an order no
+        // other angle-locked effect makes, a cogging order the rig file does not predict.
         let floor = s.floor(2, 200);
         if let Some((k, a)) = s.strongest(2, 200) {
-            if k % pp != 0 && k != lcm && a > 6.0 * floor {
-                cogging_orders.push(k);
+            if a > 6.0 * floor {
+                match RIPPLE_PISTONS.iter().find(|z| ripple_order(**z) == k) {
+                    Some(z) => ripple_pistons.push(*z),
+                    None if k % pp != 0 && k != lcm => cogging_orders.push(k),
+                    None => {}
+                }
             }
         }
     }
     // 4. Candidates fitted on the identification rows.
-    let cands = candidates(rig, &supported, theta.is_some(), &cogging_orders);
+    let cands = candidates(
+        rig,
+        &supported,
+        theta.is_some(),
+        &cogging_orders,
+        &ripple_pistons,
+    );
     // The free-payload pressure replay, only when the piston moves: the baseline of the
     // cylinder's candidates, and the contract's baseline pressure if one of them is kept.
     let cylinder_baseline: BTreeMap<&'static str, Vec<f64>> =

@@ -277,9 +277,13 @@ fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The usual odd piston counts of axial piston pumps, the ones the diagnosis tries.
+pub const RIPPLE_PISTONS: [u32; 3] = [7, 9, 11];
+
 /// Every candidate the log can show, given the predictors it supports (`predictors`),
-/// whether it logs the shaft angle, and the orders the residual spectrum points at
-/// (`cogging_orders`; the rig's slot/pole order when empty). Every predictor with tolerance
+/// whether it logs the shaft angle, the orders the residual spectrum points at
+/// (`cogging_orders`; the rig's slot/pole order when empty) and the piston counts whose
+/// ripple order it shows (`ripple_pistons`). Every predictor with tolerance
 /// coordinates gets its `none`, the nominal model within those tolerances; the angle-locked
 /// torque effects are fitted on the inner loops when they can be replayed, else on the
 /// motor replay.
@@ -288,6 +292,7 @@ pub fn candidates(
     predictors: &[Predictor],
     has_angle: bool,
     cogging_orders: &[u32],
+    ripple_pistons: &[u32],
 ) -> Vec<Candidate> {
     let supports = |p: Predictor| predictors.contains(&p);
     let ripple = if supports(Predictor::InnerLoops) {
@@ -408,15 +413,24 @@ pub fn candidates(
             c.grid = log_grid(-PI, PI * 0.75, 8);
             out.push(c);
         }
-        for z in [7, 9, 11] {
-            let mut c = one(
-                "piston_ripple",
-                Predictor::Hydraulics,
-                log_grid(-1.0, 1.5, 6),
-                1,
-            );
+        // The flow ripple on the hydraulics whatever the spectrum; the torque ripple where
+        // the spectrum shows its line, on the loops' answer to it.
+        let ripple_at = |z: u32, predictor, grid| {
+            let mut c = one("piston_ripple", predictor, grid, 1);
             c.structure = Structure::Pistons(z);
-            out.push(c);
+            c
+        };
+        out.extend(
+            RIPPLE_PISTONS
+                .iter()
+                .map(|&z| ripple_at(z, Predictor::Hydraulics, log_grid(-1.0, 1.5, 6))),
+        );
+        if supports(Predictor::InnerLoops) {
+            out.extend(
+                ripple_pistons
+                    .iter()
+                    .map(|&z| ripple_at(z, Predictor::InnerLoops, log_grid(-1.0, 2.5, 8))),
+            );
         }
     }
     out
