@@ -11,9 +11,8 @@
 //! `cargo run --release -p tests --example blind_probe [SPEC …]`
 
 use closed_loop::{by_name, SCENARIOS};
-use host_sim::bench_log::Signal;
 use plant_model::Effect;
-use tests::blind::{draw, signature};
+use tests::blind::{draw, signature, LOGGED};
 
 /// Every effect at the weak end of the generator's range (both piston counts and both
 /// directions of a wrong precharge).
@@ -33,15 +32,6 @@ const WEAK: [&str; 13] = [
     "current_sensor_offset:offset_a=0.2",
 ];
 
-const SIGNALS: [Signal; 6] = [
-    Signal::Pressure,
-    Signal::Speed,
-    Signal::Iq,
-    Signal::Id,
-    Signal::Ud,
-    Signal::Uq,
-];
-
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let specs: Vec<String> = if args.is_empty() {
@@ -49,7 +39,7 @@ fn main() -> Result<(), String> {
     } else {
         args
     };
-    let header: Vec<&str> = SIGNALS.iter().map(|s| s.name()).collect();
+    let header: Vec<&str> = LOGGED.iter().map(|s| s.name()).collect();
     println!(
         "effect RMS / noise RMS ; attainable fit gain [points]\n| effect | scenario | {} |",
         header.join(" | ")
@@ -71,7 +61,7 @@ fn main() -> Result<(), String> {
             d.scenario = *by_name(sc.name).ok_or("scenario")?;
             let t_from = d.scenario.duration_s / 2.0;
             let mut row = format!("| {spec} | {} |", sc.name);
-            for s in SIGNALS {
+            for s in LOGGED {
                 let g = signature(&d, s, t_from)?;
                 row += &format!(" {:.2} ; {:.1} |", g.ratio(), g.attainable_fit_gain());
             }

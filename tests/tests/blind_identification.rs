@@ -11,6 +11,17 @@
 //! - improve the validation-segment fit on the signal where the effect shows most by at
 //!   least 10 points.
 //!
+//! One pair is indistinguishable on some logs, and the suite says which: piston ripple of
+//! 1–3× kinematic is a torque of 0.01–0.03 N·m at the holding's 5 MPa, a line in the q
+//! current below its noise per sample. Where even a model that has the ripple exactly,
+//! added to a perfect model of the drawn rig and fitted on the very rows it is scored on,
+//! gains less than the 10 points ([`tests::blind::ripple_fit_bound`], computed by the
+//! generator's side from the truth), the log does not tell the ripple from `none` at the
+//! suite's standard: `none` is as right as the ripple, and no gain or amplitude is owed
+//! (every amplitude between none and the truth is equally indistinguishable). Where the
+//! bound reaches 10 points, the ripple is held to everything above. A third test shows that
+//! no other scenario or signal would do better.
+//!
 //! The diagnosis is read only through the contract's JSON (`shared/contracts/eha-cli.md`):
 //! the suite depends on the contract, not on the diagnosis's Rust types. The truth numbers
 //! come from the generator's draw, never from the diagnosis.
@@ -18,16 +29,18 @@
 //! A second test checks the generator itself, independently of the diagnosis: every hidden
 //! effect's noise-free signature on its signal stands above the sensor noise.
 
+use closed_loop::{by_name, SCENARIOS};
 use host_sim::bench_log;
 use host_sim::diagnose::diagnose;
 use plant_model::pump::kinematic_ripple_ratio;
-use plant_model::Rig;
+use plant_model::{Effect, Rig};
 use rayon::prelude::*;
 use serde_json::Value;
 use std::f64::consts::{PI, TAU};
 use std::path::PathBuf;
 use tests::blind::{
-    draw, generate, signature, Truth, BELOW_NOISE, SUITE_SEEDS, UNOBSERVABLE_PARAMETERS,
+    angle_locked_fit_bound, draw, generate, ripple_fit_bound, ripple_orders, signature, Truth,
+    BELOW_NOISE, LOGGED, SUITE_SEEDS, UNOBSERVABLE_PARAMETERS,
 };
 
 /// Relative tolerance on a fitted continuous parameter. [1]
@@ -86,8 +99,20 @@ fn read_said(json: &Value, signal: &str) -> Result<Said, String> {
     })
 }
 
+/// One seed: what was hidden, what the diagnosis said.
+struct SeedRun {
+    seed: u64,
+    truth: Truth,
+    /// The piston ripple's fit bound ([`ripple_fit_bound`]) when the seed hides one.
+    /// [percentage points]
+    bound: Option<f64>,
+    said: Result<Said, String>,
+}
+
 /// Generates, reads back and diagnoses one seed.
-fn run_seed(seed: u64) -> (Truth, Result<Said, String>) {
+fn run_seed(seed: u64) -> SeedRun {
+    let bound = ripple_fit_bound(&draw(seed))
+        .unwrap_or_else(|e| panic!("seed {seed}: the ripple's bound failed: {e}"));
     let (path, truth) = match generate(seed, &log_dir()) {
         Ok(g) => g,
         Err(e) => panic!("seed {seed}: the generator failed: {e}"),
@@ -99,7 +124,12 @@ fn run_seed(seed: u64) -> (Truth, Result<Said, String>) {
         })
         .and_then(|d| serde_json::to_value(&d).map_err(|e| format!("to JSON: {e}")))
         .and_then(|json| read_said(&json, truth.signal));
-    (truth, said)
+    SeedRun {
+        seed,
+        truth,
+        bound,
+        said,
+    }
 }
 
 /// A parameter's value as the plant understands it: `amplitude_ratio = 0` is the kinematic
@@ -186,25 +216,26 @@ fn show_fit(f: Option<f64>) -> String {
 }
 
 #[test]
-#[ignore = "issue 5 is open: the diagnosis passes 33 of the 36 seeds (not yet piston \
-            ripple, which stays at the sensors' floor); run \
-            with `cargo test -p tests --test blind_identification -- --ignored --nocapture` \
-            for the table"]
 fn the_diagnosis_finds_every_hidden_effect() {
-    let results: Vec<(u64, Truth, Result<Said, String>)> = (0..SUITE_SEEDS)
-        .into_par_iter()
-        .map(|seed| {
-            let (truth, said) = run_seed(seed);
-            (seed, truth, said)
-        })
-        .collect();
+    let results: Vec<SeedRun> = (0..SUITE_SEEDS).into_par_iter().map(run_seed).collect();
 
     println!(
-        "| seed | hidden effect | scenario | signal | truth parameters | named | fitted parameters | baseline fit [%] | extended fit [%] | gain [points] | verdict |"
+        "| seed | hidden effect | scenario | signal | truth parameters | named | fitted parameters | baseline fit [%] | extended fit [%] | gain [points] | attainable [points] | verdict |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut failures = Vec::new();
-    for (seed, truth, said) in &results {
+    for SeedRun {
+        seed,
+        truth,
+        bound,
+        said,
+    } in &results
+    {
+        // A ripple no model could gain the 10 points with on this log is, at the suite's
+        // standard, indistinguishable from none: either answer is right, and neither a
+        // gain nor an amplitude is owed (every amplitude between none and the truth is
+        // equally indistinguishable).
+        let indistinguishable = bound.is_some_and(|b| b < MIN_FIT_GAIN);
         let truth_params: Vec<(String, f64)> = truth
             .parameters
             .iter()
@@ -217,12 +248,14 @@ fn the_diagnosis_finds_every_hidden_effect() {
                 ("—".to_string(), "—".to_string(), None, None)
             }
             Ok(s) => {
-                if s.effect != truth.effect_name {
+                if s.effect == truth.effect_name {
+                    if !indistinguishable {
+                        wrong.extend(parameter_failures(truth, &s.parameters));
+                    }
+                } else if !(indistinguishable && s.effect == "none") {
                     wrong.push(format!("named `{}`", s.effect));
-                } else {
-                    wrong.extend(parameter_failures(truth, &s.parameters));
                 }
-                if truth.effect_name != "none" {
+                if truth.effect_name != "none" && !indistinguishable {
                     match (s.baseline_fit, s.extended_fit) {
                         (Some(b), Some(e)) if e - b >= MIN_FIT_GAIN => {}
                         (Some(b), Some(e)) => wrong.push(format!(
@@ -250,14 +283,19 @@ fn the_diagnosis_finds_every_hidden_effect() {
         } else {
             wrong.join("; ")
         };
+        let verdict = match (indistinguishable, verdict.as_str()) {
+            (true, "ok") => "ok (indistinguishable from none at 10 points)".to_string(),
+            _ => verdict,
+        };
         println!(
-            "| {seed} | {} | {} | {} | {} | {named} | {fitted} | {} | {} | {gain} | {verdict} |",
+            "| {seed} | {} | {} | {} | {} | {named} | {fitted} | {} | {} | {gain} | {} | {verdict} |",
             truth.effect_name,
             truth.scenario,
             truth.signal,
             show_params(&truth_params),
             show_fit(base),
             show_fit(ext),
+            show_fit(*bound),
         );
         if !wrong.is_empty() {
             failures.push(format!("seed {seed} ({}): {verdict}", truth.effect_name));
@@ -285,6 +323,80 @@ fn the_suite_covers_every_effect_twice_and_none() {
         );
     }
     const { assert!(SUITE_SEEDS >= 30) };
+}
+
+/// The generator's scenario and signal for piston ripple are where an angle-locked model
+/// could gain most, and everywhere else even the strong end of its range (three times
+/// kinematic) leaves any such model below the 10 points: for every suite seed that hides
+/// the ripple, with its own tolerances and noise, in every scenario, the upper bound of
+/// [`angle_locked_fit_bound`] on every logged signal.
+#[test]
+fn piston_ripple_shows_most_where_the_generator_puts_it() {
+    let cases: Vec<(u64, &str)> = (0..SUITE_SEEDS)
+        .filter(|&s| draw(s).truth.effect_name == "piston_ripple")
+        .flat_map(|s| SCENARIOS.iter().map(move |sc| (s, sc.name)))
+        .collect();
+    assert!(!cases.is_empty(), "the suite hides no piston ripple");
+    let rows: Vec<(u64, &str, &str, Vec<f64>)> = cases
+        .into_par_iter()
+        .map(|(seed, scenario)| {
+            let mut d = draw(seed);
+            let drawn_scenario = d.truth.scenario;
+            let Effect::PistonRipple { pistons, .. } = d.effect else {
+                unreachable!("filtered on the effect's name")
+            };
+            d.effect = Effect::PistonRipple {
+                pistons,
+                amplitude_ratio: 3.0 * kinematic_ripple_ratio(pistons),
+            };
+            d.scenario = *by_name(scenario).expect("a listed scenario");
+            let bound = angle_locked_fit_bound(
+                &d,
+                &LOGGED,
+                d.scenario.duration_s / 2.0,
+                &ripple_orders(pistons),
+            )
+            .unwrap_or_else(|e| panic!("seed {seed}, {scenario}: {e}"));
+            (seed, scenario, drawn_scenario, bound)
+        })
+        .collect();
+    let names: Vec<&str> = LOGGED.iter().map(|s| s.name()).collect();
+    println!("| seed | scenario | {} |", names.join(" | "));
+    let mut failures = Vec::new();
+    for (seed, scenario, drawn_scenario, bound) in &rows {
+        let cells: Vec<String> = bound.iter().map(|g| format!("{g:.1}")).collect();
+        println!("| {seed} | {scenario} | {} |", cells.join(" | "));
+        let signal = draw(*seed).truth.signal;
+        let on_signal = names
+            .iter()
+            .position(|n| *n == signal)
+            .map(|k| bound[k])
+            .expect("the truth's signal is logged");
+        let best_elsewhere = rows
+            .iter()
+            .filter(|(s, _, _, _)| s == seed)
+            .flat_map(|(_, sc, _, b)| {
+                b.iter()
+                    .zip(&names)
+                    .filter(move |(_, n)| !(sc == drawn_scenario && **n == signal))
+                    .map(|(g, _)| *g)
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        if scenario == drawn_scenario && on_signal < best_elsewhere {
+            failures.push(format!(
+                "seed {seed}: {signal} in {scenario} bounds {on_signal:.1} points, \
+                 another scenario or signal {best_elsewhere:.1}"
+            ));
+        }
+        if scenario != drawn_scenario {
+            for (g, n) in bound.iter().zip(&names) {
+                if *g >= MIN_FIT_GAIN {
+                    failures.push(format!("seed {seed}, {scenario}, {n}: {g:.1} points"));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]
