@@ -12,8 +12,9 @@ use serde_json::Value;
 use std::fs;
 use std::path::PathBuf;
 
-/// Simulates `scenario` with `effects` into a log in a fresh folder, then diagnoses it.
-fn diagnose(name: &str, scenario: &str, effects: Option<&str>) -> (Value, PathBuf) {
+/// Simulates `scenario` with `effects` into `run.csv` in a fresh folder; the folder and
+/// the log.
+fn simulate(name: &str, scenario: &str, effects: Option<&str>) -> (PathBuf, PathBuf) {
     let dir = scratch("diagnose", name);
     let log = dir.join("run.csv");
     let mut args = vec![
@@ -32,6 +33,12 @@ fn diagnose(name: &str, scenario: &str, effects: Option<&str>) -> (Value, PathBu
     }
     let o = eha(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (dir, log)
+}
+
+/// Simulates `scenario` with `effects` into a log in a fresh folder, then diagnoses it.
+fn diagnose(name: &str, scenario: &str, effects: Option<&str>) -> (Value, PathBuf) {
+    let (dir, log) = simulate(name, scenario, effects);
     let json = dir.join("diagnosis.json");
     let report = dir.join("report");
     let o = eha(&[
@@ -127,4 +134,44 @@ fn a_gas_loss_in_the_absorber_is_named_and_measured() {
     let p0 = param(&v, "precharge_pa");
     assert!((p0 / 1.8e6 - 1.0).abs() < 0.2, "{p0}");
     assert!(gain(&v, "p_pa") >= 10.0, "{v:#}");
+}
+
+#[test]
+fn a_transducer_lag_shows_as_its_phase_delay_at_the_payload_resonance() {
+    // A first-order lag τ delays a ringing at ω by atan(ω·τ)/ω. After a speed step the free
+    // payload rings on the oil spring at ω_h = √(2·β·A²/(V·m)) = √(2·6.5e8·(71e-4)²/
+    // (450e-6·2000)) = 270 rad/s (43 Hz): 7 ms of lag is 1.084/270 = 4.0 ms of delay there.
+    let (_, log) = simulate(
+        "lag-signature",
+        "speed-step",
+        Some("pressure_sensor_lag:time_constant_s=7e-3"),
+    );
+    let bench = host_sim::bench_log::read(&log).expect("the simulated log reads back");
+    let a = host_sim::diagnose::analysis::analyse(&bench, &plant_model::Rig::nominal())
+        .expect("diagnosis");
+    let p = a
+        .signatures
+        .iter()
+        .find(|g| g.signal == "p_pa")
+        .expect("the pressure's signature");
+    let omega_h = (2.0 * 6.5e8 * 71e-4f64.powi(2) / (450e-6 * 2000.0)).sqrt();
+    let expected = (omega_h * 7e-3).atan() / omega_h;
+    // One log row (1 ms) of resolution.
+    assert!(
+        (p.lag_s - expected).abs() <= 1.0e-3,
+        "{} vs {expected}",
+        p.lag_s
+    );
+    // A lag is the evidence the ranking quotes for it.
+    let cause = a
+        .diagnosis
+        .causes
+        .iter()
+        .find(|c| c.effect == "pressure_sensor_lag")
+        .expect("ranked");
+    assert!(
+        cause.evidence.contains("lags the model by"),
+        "{}",
+        cause.evidence
+    );
 }

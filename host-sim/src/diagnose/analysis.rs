@@ -21,6 +21,7 @@ use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 use super::fit::{fit, CandidateFit, Target};
 use super::predict::{piston_moves, predict, Predicted, Predictor};
 use super::replay::{unwrap_angle, ReplayError, INITIAL_SAMPLES};
+use super::signatures::{residual_signature, Regressors, ResidualSignature};
 use super::spectrum::{order_spectrum, OrderSpectrum};
 use super::{fit_percent, DiagnoseError};
 use crate::bench_log::{BenchLog, Signal};
@@ -68,6 +69,8 @@ pub struct Analysis {
     pub extended: BTreeMap<&'static str, Vec<f64>>,
     /// Order spectra of the baseline residuals (pressure, speed), when the shaft turned.
     pub spectra: Vec<(&'static str, OrderSpectrum)>,
+    /// Time-domain signatures of the baseline residuals, one per predicted signal.
+    pub signatures: Vec<ResidualSignature>,
     /// Orders the candidates point at, for the plots: (order, effect).
     pub candidate_orders: Vec<(u32, &'static str)>,
     /// Every candidate's fit.
@@ -299,8 +302,14 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         .keys()
         .filter_map(|k| Some((*k, column(log, k)?.to_vec())))
         .collect();
-    // 3. Evidence: order spectra of the residuals.
-    let theta = log.theta_m_rad.as_deref().map(unwrap_angle);
+    // 3. Evidence: the residuals' time-domain signatures and order spectra (against the
+    // logged angle, else against the angle the logged speed integrates to).
+    let signatures = residual_signatures(log, &measured, &baseline, from);
+    let has_angle = log.theta_m_rad.is_some();
+    let theta = match log.theta_m_rad.as_deref() {
+        Some(th) => Some(unwrap_angle(th)),
+        None => integrated_angle(&log.t_s, &log.speed_rad_s),
+    };
     let mut spectra = Vec::new();
     if let Some(th) = &theta {
         for name in ["p_pa", "speed_rad_s"] {
@@ -332,13 +341,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         }
     }
     // 4. Candidates fitted on the identification rows.
-    let cands = candidates(
-        rig,
-        &supported,
-        theta.is_some(),
-        &cogging_orders,
-        &ripple_pistons,
-    );
+    let cands = candidates(rig, &supported, has_angle, &cogging_orders, &ripple_pistons);
     // The free-payload pressure replay, only when the piston moves: the baseline of the
     // cylinder's candidates, and the contract's baseline pressure if one of them is kept.
     let cylinder_baseline: BTreeMap<&'static str, Vec<f64>> =
@@ -503,6 +506,11 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             s.push_str("; ");
             s.push_str(&line);
         }
+        let own = f.candidate.predictor.signals();
+        if let Some(sig) = signatures.iter().find(|g| own.contains(&g.signal)) {
+            s.push_str("; ");
+            s.push_str(&sig.phrase_for(f.candidate.name));
+        }
         s
     };
     let none_cause = |score: f64, why: String| Cause {
@@ -515,11 +523,14 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         let f = &fits[*i];
         causes.push(cause_of(f, rig, describe(f)));
     } else {
-        causes.push(none_cause(
-            1.0 - best_explained,
+        let mut why =
             "no effect of the catalogue beyond the rig's tolerances improves the validation segment"
-                .into(),
-        ));
+                .to_string();
+        for sig in &signatures {
+            why.push_str("; ");
+            why.push_str(&sig.whiteness_phrase());
+        }
+        causes.push(none_cause(1.0 - best_explained, why));
     }
     // The other candidates, best first, one entry per effect.
     for (i, f) in fits.iter().enumerate() {
@@ -573,9 +584,56 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         baseline: base_contract,
         extended: ext_pred,
         spectra,
+        signatures,
         candidate_orders,
         fits,
     })
+}
+
+/// The time-domain signatures of every baseline residual, over the rows from `from`.
+fn residual_signatures<'a>(
+    log: &'a BenchLog,
+    measured: &BTreeMap<&'static str, Vec<f64>>,
+    baseline: &'a BTreeMap<&'static str, Vec<f64>>,
+    from: usize,
+) -> Vec<ResidualSignature> {
+    let n = log.len();
+    if n < from + 2 {
+        return Vec::new();
+    }
+    let dt = (log.t_s[n - 1] - log.t_s[from]) / (n - 1 - from) as f64;
+    // The model's operating point where it predicts it (a residual correlates with its own
+    // measured signal through the noise alone), else the logged one.
+    let point = |name: &str, logged: &'a [f64]| -> &'a [f64] {
+        baseline.get(name).map_or(logged, Vec::as_slice)
+    };
+    let with = Regressors {
+        speed_rad_s: &point("speed_rad_s", &log.speed_rad_s)[from..],
+        p_pa: &point("p_pa", &log.p_pa)[from..],
+        iq_a: &point("iq_a", &log.iq_a)[from..],
+    };
+    measured
+        .iter()
+        .filter_map(|(name, y)| {
+            let y_hat = baseline.get(name)?;
+            residual_signature(name, dt, y.get(from..)?, y_hat.get(from..)?, &with)
+        })
+        .collect()
+}
+
+/// The shaft angle the logged speed integrates to (trapezoids), for the order spectrum of
+/// a log without the angle; `None` for fewer than two rows. [rad]
+fn integrated_angle(t: &[f64], speed: &[f64]) -> Option<Vec<f64>> {
+    if t.len() < 2 || speed.len() != t.len() {
+        return None;
+    }
+    let mut theta = Vec::with_capacity(t.len());
+    theta.push(0.0);
+    for k in 1..t.len() {
+        let step = 0.5 * (speed[k] + speed[k - 1]) * (t[k] - t[k - 1]);
+        theta.push(theta[k - 1] + step);
+    }
+    Some(theta)
 }
 
 fn cause_of(f: &CandidateFit, rig: &Rig, evidence: String) -> Cause {
@@ -649,9 +707,11 @@ fn angle_locked_order(c: &Candidate, rig: &Rig) -> Option<(&'static str, u32)> {
         ("cogging_torque", super::candidates::Structure::Order(k)) => ("speed_rad_s", k),
         ("flux_harmonics", _) => ("speed_rad_s", 6 * pp),
         ("current_sensor_offset", _) => ("speed_rad_s", pp),
-        ("piston_ripple", super::candidates::Structure::Pistons(z)) => {
-            ("p_pa", if z % 2 == 1 { 2 * z } else { z })
-        }
+        // The flow ripple shows in the pressure, the torque ripple in the shaft speed.
+        ("piston_ripple", super::candidates::Structure::Pistons(z)) => match c.predictor {
+            Predictor::InnerLoops => ("speed_rad_s", ripple_order(z)),
+            _ => ("p_pa", ripple_order(z)),
+        },
         _ => return None,
     })
 }
@@ -670,4 +730,26 @@ fn order_evidence(
         s.at(order),
         s.at(order) / floor.max(f64::MIN_POSITIVE)
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_speed_integrates_to_the_angle_turned() {
+        // 1000 rows over 1 s: a ramp 0 → 20 rad/s turns ½·20·1 = 10 rad (trapezoids are
+        // exact on a ramp), then 5 rad/s for another second turns 5 more.
+        let t: Vec<f64> = (0..2001).map(|k| k as f64 * 1e-3).collect();
+        let w: Vec<f64> = t
+            .iter()
+            .map(|&t| if t <= 1.0 { 20.0 * t } else { 5.0 })
+            .collect();
+        let th = integrated_angle(&t, &w).expect("rows");
+        assert!((th[1000] - 10.0).abs() < 1e-9, "{}", th[1000]);
+        // The one step from 20 to 5 rad/s is averaged: (20 + 5)/2·1 ms, then 999 ms at 5.
+        let expected = 10.0 + 12.5e-3 + 5.0 * 0.999;
+        assert!((th[2000] - expected).abs() < 1e-9, "{}", th[2000]);
+        assert!(integrated_angle(&t[..1], &w[..1]).is_none());
+    }
 }

@@ -24,6 +24,7 @@ pub mod fit;
 pub mod predict;
 pub mod replay;
 pub mod report;
+pub mod signatures;
 pub mod spectrum;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};

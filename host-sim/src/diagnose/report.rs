@@ -104,6 +104,31 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
             c.evidence
         );
     }
+    if !a.signatures.is_empty() {
+        let _ = writeln!(
+            md,
+            "\n## Residual signatures (baseline, measured − simulated)\n\n\
+             | signal | RMS | Ljung–Box Q ({} lags) | p (white) | corr. speed | corr. pressure | \
+             corr. q current | lag [ms] | standstill / running RMS |\n|---|---|---|---|---|---|---|---|---|",
+            super::signatures::WHITENESS_LAGS
+        );
+        for g in &a.signatures {
+            let _ = writeln!(
+                md,
+                "| `{}` | {:.4e} | {:.0} | {:.3} | {:+.2} | {:+.2} | {:+.2} | {:.1} | {} |",
+                g.signal,
+                g.rms,
+                g.ljung_box_q,
+                g.white_p,
+                g.corr_speed,
+                g.corr_pressure,
+                g.corr_current,
+                1e3 * g.lag_s,
+                g.standstill_ratio
+                    .map_or("—".to_string(), |k| format!("{k:.2}"))
+            );
+        }
+    }
     // Traces of the lead cause's signals (pressure and speed when none).
     let signals: Vec<&'static str> = a
         .fits
