@@ -247,3 +247,62 @@ fn inner_loop_replay_applies_the_pump_torque_ripple_at_the_logged_angle() {
     assert!(none - right > 0.8 * ripple_power, "{none} − {right}");
     assert!(wrong > none, "{wrong} vs {none}");
 }
+
+#[test]
+fn lock_in_recovers_a_ripple_amplitude_the_simplex_left_off() {
+    use host_sim::diagnose::analysis::{predictors, scored_rows, segments};
+    use host_sim::diagnose::candidates::{candidates, Structure};
+    use host_sim::diagnose::fit::{CandidateFit, Target};
+    use host_sim::diagnose::lock_in::refine_ripple_amplitude;
+    use host_sim::diagnose::predict::{predict, Predictor};
+    use plant_model::pump::kinematic_ripple_ratio;
+    // A 9-piston pump at twice its kinematic ripple, holding 5 MPa on the nominal rig: a
+    // q-current line below the current's noise per sample.
+    let truth_ratio = 2.0 * kinematic_ripple_ratio(9);
+    let mut truth = Rig::nominal();
+    truth.pump.piston_ripple = true;
+    truth.pump.ripple_amplitude_ratio = truth_ratio;
+    let scenario = by_name("pressure-hold").expect("scenario exists");
+    let options = RunOptions {
+        duration_s: 3.0,
+        log_rate_hz: 1e3,
+        seed: 17,
+        progress: false,
+        metadata: Vec::new(),
+    };
+    let log = run(&truth, &Rig::nominal(), scenario, &options)
+        .expect("run")
+        .log;
+    let nominal = Rig::nominal();
+    let c = candidates(&nominal, &predictors(&log), true, &[72], &[9])
+        .into_iter()
+        .find(|c| {
+            c.name == "piston_ripple"
+                && c.predictor == Predictor::InnerLoops
+                && c.structure == Structure::Pistons(9)
+        })
+        .expect("the inner loops' 9-piston ripple");
+    let (split, from) = segments(&log);
+    let (from, rows) = scored_rows(&log, c.predictor, split, from);
+    let base = predict(&log, &nominal, c.predictor, rows, 0.0).expect("replay");
+    let target = Target::new(&log, &nominal, rows, from, &base);
+    // Start 60 % high and 40 % low (ln 1.6, ln 0.6 from the truth), tolerances nominal.
+    for off in [1.6f64, 0.6] {
+        let mut u = c.start.clone();
+        u[0] = (truth_ratio * off / kinematic_ripple_ratio(9)).ln();
+        let cost = target.cost(&c, &u);
+        let start = CandidateFit {
+            candidate: c.clone(),
+            u,
+            cost,
+            evaluations: 0,
+        };
+        let refined = refine_ripple_amplitude(&target, start);
+        let fitted = kinematic_ripple_ratio(9) * refined.u[0].exp();
+        eprintln!("from {off}× the truth: {fitted:.4} against {truth_ratio:.4}");
+        assert!(
+            (fitted / truth_ratio - 1.0).abs() < 0.1,
+            "{fitted} vs {truth_ratio}"
+        );
+    }
+}

@@ -19,6 +19,7 @@ use super::candidates::{candidates, tolerance_dims, Candidate, RIPPLE_PISTONS};
 use super::closed_replay::{hold_scored_from, replay_closed_loop, scenario_of};
 use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 use super::fit::{fit, CandidateFit, Target};
+use super::lock_in::refine_ripple_amplitude;
 use super::predict::{piston_moves, predict, Predicted, Predictor};
 use super::replay::{unwrap_angle, ReplayError, INITIAL_SAMPLES};
 use super::signatures::{residual_signature, Regressors, ResidualSignature};
@@ -409,7 +410,10 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         .collect();
     let mut fits: Vec<CandidateFit> = effects
         .par_iter()
-        .filter_map(|c| Some(fit(targets.get(&c.predictor)?, c)))
+        .filter_map(|c| {
+            let t = targets.get(&c.predictor)?;
+            Some(refine_ripple_amplitude(t, fit(t, c)))
+        })
         .collect();
     // The nominal model within its tolerances, per predictor: the reference every
     // candidate of that predictor must beat (costs become relative to it).

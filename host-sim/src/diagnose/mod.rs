@@ -21,6 +21,7 @@ pub mod command;
 pub mod diagnosis;
 pub mod electrical;
 pub mod fit;
+pub mod lock_in;
 pub mod predict;
 pub mod replay;
 pub mod report;
