@@ -315,7 +315,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     if let Some(th) = &theta {
         for name in ["p_pa", "speed_rad_s"] {
             if let (Some(y), Some(y_hat)) = (measured.get(name), baseline.get(name)) {
-                let r: Vec<f64> = y.iter().zip(y_hat).map(|(a, b)| a - b).collect();
+                let r = super::residual(y, y_hat);
                 if let Some(s) = order_spectrum(&th[from..], &r[from..]) {
                     spectra.push((name, s));
                 }

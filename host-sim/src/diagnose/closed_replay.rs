@@ -50,7 +50,7 @@ use crate::bench_log::BenchLog;
 use closed_loop::scenario::MAX_EVENTS;
 use closed_loop::{controller_config, ClosedLoop, Scenario, ScenarioKind};
 use firmware::{Command, Mode};
-use plant_model::motor::Motor;
+use plant_model::motor::{Motor, Phasor};
 use plant_model::pump::Pump;
 use plant_model::Rig;
 
@@ -99,14 +99,17 @@ impl AngleLockedTorques {
     /// Their torque on the shaft at shaft angle `theta` [rad] with the port pressures
     /// (p_A, p_B) [Pa], in the motor's direction. [N·m]
     fn torque_nm(&self, theta: f64, (p_a, p_b): (f64, f64)) -> f64 {
+        // One sine and cosine of the angle serve both.
+        let rot = Phasor::of(theta);
         let cogging = self
             .cogging
             .as_ref()
-            .map_or(0.0, |m| m.cogging_torque_nm(theta));
-        // The pump's load torque is D/2π·factor·Δp; the plant without the ripple applies
-        // factor 1, so the rest opposes the motor.
+            .map_or(0.0, |m| m.cogging_torque_at(rot));
+        // The plant without the ripple loads the shaft with the mean displacement (factor
+        // 1); the rest of the pump's own load torque opposes the motor.
         let ripple = self.ripple.as_ref().map_or(0.0, |p| {
-            -p.displacement_m3_per_rad * (p.displacement_factor(theta) - 1.0) * (p_a - p_b)
+            let factor = p.displacement_factor_at(theta, rot);
+            p.load_torque(p_a, p_b, 1.0) - p.load_torque(p_a, p_b, factor)
         });
         cogging + ripple
     }

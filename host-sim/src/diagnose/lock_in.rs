@@ -12,7 +12,7 @@ use super::candidates::{Candidate, Structure};
 use super::fit::{CandidateFit, Target};
 use super::predict::{predict, Predictor};
 use super::replay::unwrap_angle;
-use plant_model::pump::{kinematic_ripple_ratio, ripple_order};
+use plant_model::pump::ripple_order;
 
 /// Harmonics of the ripple's fundamental order the projection keeps. [1]
 pub const HARMONICS: u32 = 4;
@@ -71,25 +71,17 @@ fn amplitude_ratio(target: &Target<'_>, f: &CandidateFit, z: u32) -> Option<f64>
             phase.sin()
         }
     });
-    let svd = basis.clone().svd(true, true);
-    let project = |y: nalgebra::DVector<f64>| -> Option<nalgebra::DVector<f64>> {
-        Some(&basis * svd.solve(&y, 1e-12).ok()?)
-    };
-    let residual = nalgebra::DVector::from_iterator(
-        rows.len(),
-        rows.iter().map(|&k| log.iq_a[k] - iq_without[k]),
-    );
     let response = nalgebra::DVector::from_iterator(
         rows.len(),
         rows.iter().map(|&k| iq_with[k] - iq_without[k]),
     );
-    let response = project(response)?;
-    let power = response.norm_squared();
-    if power <= 0.0 {
-        return None;
-    }
-    // ⟨P r, P Δ⟩ = ⟨r, P Δ⟩: the projection of the residual is implicit.
-    let ratio = residual.dot(&response) / power;
-    let amplitude = kinematic_ripple_ratio(z) * f.u.first()?.exp() * ratio;
-    (ratio > 0.0 && amplitude.is_finite()).then_some(ratio)
+    let coefficients = basis.clone().svd(true, true).solve(&response, 1e-12).ok()?;
+    let response = &basis * coefficients;
+    let residual = nalgebra::DVector::from_iterator(
+        rows.len(),
+        rows.iter().map(|&k| log.iq_a[k] - iq_without[k]),
+    );
+    // ⟨P r, P Δ⟩ = ⟨r, P Δ⟩: the residual's projection is implicit.
+    let ratio = residual.dot(&response) / response.norm_squared();
+    (ratio.is_finite() && ratio > 0.0).then_some(ratio)
 }

@@ -90,7 +90,7 @@ pub fn residual_signature(
     if n < 2 * WHITENESS_LAGS || lengths.iter().any(|l| *l != n) || dt_s.is_nan() || dt_s <= 0.0 {
         return None;
     }
-    let r: Vec<f64> = measured.iter().zip(simulated).map(|(m, s)| m - s).collect();
+    let r = super::residual(measured, simulated);
     let rms = (r.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
     let q = ljung_box(&r, WHITENESS_LAGS);
     let white_p = ChiSquared::new(WHITENESS_LAGS as f64)
@@ -220,17 +220,11 @@ fn best_shift(measured: &[f64], simulated: &[f64], max: usize) -> i64 {
     };
     (-max..=max)
         .map(|s| (s, score(s)))
-        .fold((0, f64::NEG_INFINITY), |best, (s, c)| {
-            if c > best.1 {
-                (s, c)
-            } else {
-                best
-            }
-        })
-        .0
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0, |(s, _)| s)
 }
 
-/// The lag over the window about the model's fastest change (from [`MAX_LAG_S`] before it
+/// The lag over the window about the model's fastest change (from twice [`MAX_LAG_S`] before it
 /// to [`LAG_WINDOW_S`] after): a lag shows where the signal moves, and over a short window
 /// a slightly wrong resonance or rate in the model (the rig's tolerances) has no time to
 /// drift out of phase. [s]
