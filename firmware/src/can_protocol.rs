@@ -58,7 +58,7 @@
 //! | bytes | type  | content                                                          |
 //! |-------|-------|------------------------------------------------------------------|
 //! | 0     | `u8`  | mode code                                                        |
-//! | 1     | `u8`  | fault code of the controller (`0` = no fault)                    |
+//! | 1     | `u8`  | latched fault code ([`crate::FaultCode`], `1`‥`18`; `0` = no fault) |
 //! | 2‥3   | `i16` | measured pressure, gauge, 1 kPa per LSB (saturating)             |
 //! | 4‥5   | `i16` | measured shaft speed, 0.1 rad/s per LSB (saturating)             |
 //! | 6     | `u8`  | function code of the last accepted command (`0xFF` = none yet)   |

@@ -323,6 +323,27 @@ impl Controller {
         self.sup.trip(FaultCode::ParameterStoreInvalid);
     }
 
+    /// Board entry point: the power stage's hardware break cut the bridge (gate-driver
+    /// fault line, phase-current comparator, or a break the firmware forced). Latches
+    /// [`FaultCode::HardwareBreak`] and drops to Disabled, so the bridge comes back only
+    /// after the operator cleared it.
+    pub fn report_hardware_break(&mut self) {
+        self.sup.trip(FaultCode::HardwareBreak);
+    }
+
+    /// Boot entry point: the flash is not in the layout the parameter store needs, so
+    /// nothing was loaded. Latches [`FaultCode::ParameterFlashLayout`].
+    pub fn report_parameter_flash_layout(&mut self) {
+        self.sup.trip(FaultCode::ParameterFlashLayout);
+    }
+
+    /// Boot entry point: the previous run ended in an independent-watchdog reset (a
+    /// stalled loop, a panic or a HardFault). Latches [`FaultCode::Watchdog`], so the
+    /// operator sees it before the drive runs again.
+    pub fn report_watchdog_reset(&mut self) {
+        self.sup.trip(FaultCode::Watchdog);
+    }
+
     /// Configuration in use.
     pub fn config(&self) -> &Config {
         &self.cfg

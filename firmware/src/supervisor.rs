@@ -76,7 +76,8 @@ pub enum FaultCode {
     OverSpeed = 9,
     /// No command within `limits.command_timeout_s` in an active mode. (10)
     CommandTimeout = 10,
-    /// The application reported a control-loop overrun. (11)
+    /// The application reported a control-loop overrun, or the previous run ended in an
+    /// independent-watchdog reset (a stalled loop, a panic or a HardFault). (11)
     Watchdog = 11,
     /// Calibrated current offsets out of range. (12)
     CurrentOffset = 12,
@@ -91,11 +92,19 @@ pub enum FaultCode {
     /// The stored parameter table was corrupt, of another version or inconsistent: the
     /// defaults were loaded instead. (16)
     ParameterStoreInvalid = 16,
+    /// The power stage's hardware break cut the bridge: the gate driver's fault line, a
+    /// phase-current comparator (short circuit, within microseconds) or a break forced by
+    /// the firmware itself (a stalled loop). (17)
+    HardwareBreak = 17,
+    /// The flash is not in the dual-bank layout the parameter store lives in (option bit
+    /// DBANK cleared): nothing was loaded, the defaults are in use and saves are refused.
+    /// (18)
+    ParameterFlashLayout = 18,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 16] = [
+    pub const ALL: [FaultCode; 18] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -112,9 +121,14 @@ impl FaultCode {
         FaultCode::CommissioningImplausible,
         FaultCode::CommissioningEncoder,
         FaultCode::ParameterStoreInvalid,
+        FaultCode::HardwareBreak,
+        FaultCode::ParameterFlashLayout,
     ];
 
-    /// Telemetry code (1..=16).
+    /// Largest telemetry code.
+    pub const MAX_CODE: u8 = FaultCode::ParameterFlashLayout as u8;
+
+    /// Telemetry code (1..=[`FaultCode::MAX_CODE`]).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -125,7 +139,7 @@ impl FaultCode {
     }
 
     /// Bit in a [`Conditions`] mask.
-    pub fn bit(self) -> u16 {
+    pub fn bit(self) -> u32 {
         1 << (self as u8 - 1)
     }
 
@@ -142,6 +156,8 @@ impl FaultCode {
                 | FaultCode::CommissioningImplausible
                 | FaultCode::CommissioningEncoder
                 | FaultCode::ParameterStoreInvalid
+                | FaultCode::HardwareBreak
+                | FaultCode::ParameterFlashLayout
         )
     }
 }
@@ -167,6 +183,12 @@ impl fmt::Display for FaultCode {
                 "commissioning: encoder reversed or shaft not moving"
             }
             FaultCode::ParameterStoreInvalid => "stored parameters invalid, defaults loaded",
+            FaultCode::HardwareBreak => {
+                "hardware break (gate-driver fault, comparator over-current or forced)"
+            }
+            FaultCode::ParameterFlashLayout => {
+                "flash not dual-bank (DBANK option bit): parameter store unavailable"
+            }
         };
         write!(f, "fault {}: {}", self.code(), s)
     }
@@ -174,7 +196,7 @@ impl fmt::Display for FaultCode {
 
 /// Set of fault conditions present in one sample (bit = [`FaultCode::bit`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Conditions(pub u16);
+pub struct Conditions(pub u32);
 
 impl Conditions {
     /// Adds `f` when `present`.
@@ -312,7 +334,7 @@ mod tests {
 
     #[test]
     fn codes_round_trip_and_bits_are_distinct() {
-        let mut seen = 0u16;
+        let mut seen = 0u32;
         for f in FaultCode::ALL {
             assert_eq!(FaultCode::from_code(f.code()), Some(f));
             assert_eq!(seen & f.bit(), 0);
@@ -324,6 +346,12 @@ mod tests {
             FaultCode::from_code(16),
             Some(FaultCode::ParameterStoreInvalid)
         );
+        // The codes are 1..=MAX_CODE without a gap, in enumeration order.
+        for (k, f) in FaultCode::ALL.iter().enumerate() {
+            assert_eq!(usize::from(f.code()), k + 1);
+        }
+        assert_eq!(usize::from(FaultCode::MAX_CODE), FaultCode::ALL.len());
+        assert_eq!(FaultCode::from_code(FaultCode::MAX_CODE + 1), None);
         for m in [
             Mode::Disabled,
             Mode::Calibrating,

@@ -253,7 +253,11 @@ impl fmt::Display for ParseError {
             ParseError::Missing(k) => write!(f, "field `{k}` missing or out of order"),
             ParseError::BadValue(k) => write!(f, "field `{k}` is not a number"),
             ParseError::BadMode => write!(f, "field `mode` is not a mode code (0..=3)"),
-            ParseError::BadFault => write!(f, "field `fault` is not a fault code (0..=12)"),
+            ParseError::BadFault => write!(
+                f,
+                "field `fault` is not a fault code (0..={})",
+                FaultCode::MAX_CODE
+            ),
         }
     }
 }
@@ -362,6 +366,21 @@ mod tests {
             Err(ParseError::Missing("p_ref_pa"))
         );
         assert_eq!(parse_line("EHA1 t_s=x"), Err(ParseError::BadValue("t_s")));
+        // Every fault code of the supervisor's table parses, the next one does not, and
+        // the message names the table's range.
+        let mut s = std::string::String::new();
+        frame().write_line(&mut s).unwrap();
+        let with_fault = |code: u8| s.replace(" fault=9 ", &std::format!(" fault={code} "));
+        for f in FaultCode::ALL {
+            assert_eq!(parse_line(&with_fault(f.code())).unwrap().fault, Some(f));
+        }
+        let past = FaultCode::ALL.len() as u8 + 1;
+        assert_eq!(parse_line(&with_fault(past)), Err(ParseError::BadFault));
+        let message = std::format!("{}", ParseError::BadFault);
+        assert!(
+            message.contains(&std::format!("0..={}", FaultCode::ALL.len())),
+            "{message}"
+        );
     }
 
     #[test]
