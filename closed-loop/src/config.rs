@@ -20,6 +20,8 @@ pub fn controller_config(rig: &Rig) -> Config {
     c.sensors.pressure_zero_lsb = s.pressure.zero_lsb as f32;
     c.sensors.encoder_counts_per_rev = s.encoder.counts_per_rev;
     c.sensors.encoder_offset_rad = s.encoder.offset_rad as f32;
+    // The simulated encoder reads ⌊θ/2π·N⌋ from the start: its count 0 is the index.
+    c.sensors.encoder_referenced_at_start = true;
     let m = &rig.motor;
     c.motor.pole_pairs = m.pole_pairs;
     c.motor.stator_resistance_ohm = m.r_s_ohm as f32;

@@ -189,6 +189,8 @@ impl ClosedLoop {
             adc_pressure: r.adc_pressure,
             encoder_count: r.encoder_count,
             encoder_index: r.encoder_index,
+            // The simulated counter reads 0 at its index (`controller_config` says so).
+            encoder_index_count: 0,
         });
         let out = self.controller.on_current_sample(&m);
         let recorded = record(&self.plant, &self.controller, out);

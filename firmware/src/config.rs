@@ -51,8 +51,15 @@ pub struct SensorScaling {
     pub pressure_short_lsb: u16,
     /// Encoder counts per mechanical revolution (timer ARR + 1). [counts]
     pub encoder_counts_per_rev: u32,
-    /// Electrical angle at encoder count 0: θ_e = p_n·θ_m(count) − offset. [rad]
+    /// Electrical angle at the encoder index: θ_e = p_n·θ_m(from the index) − offset.
+    /// [rad]
     pub encoder_offset_rad: f32,
+    /// The encoder counter reads 0 at the index from the first sample on (an absolute
+    /// encoder interface, or the simulated encoder). False for an incremental counter
+    /// zeroed wherever the board powered up (the NUCLEO's TIM2): the angle is then known
+    /// only once the index has been seen or the alignment has run in this power cycle
+    /// ([`crate::encoder`]), and Speed and Pressure wait for it.
+    pub encoder_referenced_at_start: bool,
 }
 
 /// Motor and inverter (nominal rig; Section 3.1, eq. 1–6).
@@ -279,6 +286,7 @@ impl Config {
                 pressure_short_lsb: 62259,
                 encoder_counts_per_rev: 10_000,
                 encoder_offset_rad: 0.0,
+                encoder_referenced_at_start: false,
             },
             motor: Motor {
                 pole_pairs: 4,

@@ -250,12 +250,19 @@ impl Controller {
                 config.sensors.encoder_counts_per_rev,
             ),
             pressure: PressureLoop::new(config),
-            encoder: Encoder::new(
-                config.sensors.encoder_counts_per_rev,
-                config.motor.pole_pairs,
-                config.sensors.encoder_offset_rad,
-                max_step,
-            ),
+            encoder: {
+                let e = Encoder::new(
+                    config.sensors.encoder_counts_per_rev,
+                    config.motor.pole_pairs,
+                    config.sensors.encoder_offset_rad,
+                    max_step,
+                );
+                if config.sensors.encoder_referenced_at_start {
+                    e
+                } else {
+                    e.with_unknown_reference()
+                }
+            },
             sup: Supervisor::new(),
             calibration: Calibration::Offsets { n: 0, sums: [0; 3] },
             active_last_call: false,
@@ -384,9 +391,23 @@ impl Controller {
         &self.commissioning
     }
 
-    /// Encoder electrical offset in use. [rad]
+    /// Encoder electrical offset in use, relative to the index. [rad]
     pub fn encoder_offset(&self) -> f32 {
         self.encoder.offset()
+    }
+
+    /// Counter value at the encoder index, once the index has been seen (or at once for a
+    /// counter referenced from the start). [counts]
+    pub fn encoder_index_count(&self) -> Option<u32> {
+        self.encoder.index_count()
+    }
+
+    /// The live table (and a later save) holds an offset the encoder has just tied to the
+    /// index (an alignment's, or one converted at the first index).
+    fn take_learned_encoder_offset(&mut self) {
+        if let Some(offset) = self.encoder.take_learned_offset() {
+            self.cfg.sensors.encoder_offset_rad = offset;
+        }
     }
 
     /// Watchdog entry point: the application calls this when a control loop overran. The
@@ -407,7 +428,12 @@ impl Controller {
     pub fn on_current_sample(&mut self, m: &Measurements) -> Outputs {
         self.samples = self.samples.wrapping_add(1);
         self.since_command = self.since_command.saturating_add(1);
-        let enc_event = self.encoder.update(m.encoder_count, m.encoder_index);
+        let enc_event =
+            self.encoder
+                .update(m.encoder_count, m.encoder_index, m.encoder_index_count);
+        if m.encoder_index {
+            self.take_learned_encoder_offset();
+        }
         // An implausible jump is not a shaft movement: the observer coasts over it, so a
         // one-sample glitch does not leave a speed transient behind after it latched its
         // fault.
@@ -620,11 +646,9 @@ impl Controller {
                 if n >= self.d.align_calls {
                     // The rotor's d axis now sits at θ_e = 0: the count's electrical angle
                     // is the offset.
-                    let raw =
-                        self.encoder.electrical_angle(m.encoder_count) + self.encoder.offset();
-                    self.encoder.set_offset(wrap_2pi(raw));
-                    // The live table (and a later save) holds the measured offset.
-                    self.cfg.sensors.encoder_offset_rad = self.encoder.offset();
+                    let raw = self.encoder.raw_electrical_angle(m.encoder_count);
+                    self.encoder.align(wrap_2pi(raw));
+                    self.take_learned_encoder_offset();
                     self.calibrated = true;
                     self.id_ref = 0.0;
                     self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
@@ -702,7 +726,15 @@ impl Controller {
                 Ok(())
             }
             Command::ClearFaults => {
+                let cleared = self.sup.fault();
                 self.sup.clear().map_err(CommandError::CausePresent)?;
+                if matches!(
+                    cleared,
+                    Some(FaultCode::EncoderJump | FaultCode::EncoderIndexLost)
+                ) {
+                    // Counts may have been lost: the counter's tie to the rotor is gone.
+                    self.encoder.forget_reference();
+                }
                 self.encoder.rearm();
                 Ok(())
             }

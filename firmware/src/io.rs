@@ -18,6 +18,9 @@ pub struct Measurements {
     pub encoder_count: u32,
     /// True when the encoder index pulse was captured since the previous sample.
     pub encoder_index: bool,
+    /// The counter value the timer captured at the index pulse's edge (valid when
+    /// `encoder_index`): ties the counter to the index ([`crate::encoder`]). [counts]
+    pub encoder_index_count: u32,
 }
 
 impl Default for Measurements {
@@ -29,6 +32,7 @@ impl Default for Measurements {
             adc_pressure: 0,
             encoder_count: 0,
             encoder_index: false,
+            encoder_index_count: 0,
         }
     }
 }

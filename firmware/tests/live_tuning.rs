@@ -19,6 +19,7 @@ fn at_rest() -> Measurements {
         adc_pressure: 6554 + 6291,
         encoder_count: 0,
         encoder_index: false,
+        encoder_index_count: 0,
     }
 }
 

@@ -70,6 +70,7 @@ fn q_step(pwm_hz: f64, seed: u64) -> Response {
             adc_pressure: s.adc_pressure,
             encoder_count: s.encoder_count,
             encoder_index: s.encoder_index,
+            encoder_index_count: 0,
         };
         let iq_ref = if k >= step_at { STEP_A as f32 } else { 0.0 };
         let out = current.step(

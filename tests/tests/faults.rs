@@ -332,6 +332,7 @@ fn isr(plant: &mut Plant, c: &mut Controller, period: f64) -> firmware::Outputs 
         adc_pressure: r.adc_pressure,
         encoder_count: r.encoder_count,
         encoder_index: r.encoder_index,
+        encoder_index_count: 0,
     });
     let d = out.duties;
     plant.advance(

@@ -1,5 +1,6 @@
 //! The sensor read-out of one PWM period: injected ADC results (phase currents, DC link,
-//! pressure) and the encoder counter with its index capture, as the control core's
+//! pressure) and the encoder counter with its index capture (the counter value latched at
+//! the index edge, which the control core ties the counter to), as the control core's
 //! [`Measurements`].
 //!
 //! Both ADCs convert at the same TIM1 trigger (the counter peak). The control interrupt
@@ -30,19 +31,20 @@ impl Sensors {
         let [pressure] = self.peripherals.pressure.read_injected_samples();
         let encoder_count = ENCODER_REGS.cnt().read();
         let encoder_index = ENCODER_REGS.sr().read().ccif(ENCODER_INDEX_CHANNEL);
-        if encoder_index {
-            // Cleared by writing 0; TIM2 has no other flag in use, so read-modify-write
-            // cannot lose one.
-            ENCODER_REGS
-                .sr()
-                .modify(|w| w.set_ccif(ENCODER_INDEX_CHANNEL, false));
-        }
+        // Reading the capture register also clears the capture flag (no read-modify-write
+        // of the status register, which could lose another flag).
+        let encoder_index_count = if encoder_index {
+            ENCODER_REGS.ccr(ENCODER_INDEX_CHANNEL).read()
+        } else {
+            0
+        };
         Measurements {
             adc_phase_current: [ia, ib, ic],
             adc_dc_link: udc,
             adc_pressure: pressure,
             encoder_count,
             encoder_index,
+            encoder_index_count,
         }
     }
 }

@@ -33,7 +33,7 @@ impl Controller {
         let input = Input {
             i_abc: self.current.phase_currents(m),
             u_dq_prev: self.state.u_dq,
-            theta_e_raw: self.encoder.electrical_angle(m.encoder_count) + self.encoder.offset(),
+            theta_e_raw: self.encoder.raw_electrical_angle(m.encoder_count),
             position_counts: self.encoder.position(),
             speed_rad_s: self.observer.filtered_speed_rad_s(),
         };
@@ -75,7 +75,7 @@ impl Controller {
             }
             Action::Done => {
                 if let Some(r) = self.commissioning.result() {
-                    self.encoder.set_offset(wrap_2pi(r.encoder_offset_rad));
+                    self.encoder.align(wrap_2pi(r.encoder_offset_rad));
                     self.current
                         .set_machine(r.d_inductance_h, r.q_inductance_h, r.flux_linkage_wb);
                     self.calibrated = true;
@@ -85,7 +85,7 @@ impl Controller {
                     m.d_inductance_h = r.d_inductance_h;
                     m.q_inductance_h = r.q_inductance_h;
                     m.flux_linkage_wb = r.flux_linkage_wb;
-                    self.cfg.sensors.encoder_offset_rad = self.encoder.offset();
+                    self.take_learned_encoder_offset();
                 }
                 self.finish_commissioning();
                 // Disabled is always granted.

@@ -18,6 +18,7 @@ fn healthy(count: u32) -> Measurements {
         adc_pressure: pressure_counts(3e6),
         encoder_count: count,
         encoder_index: false,
+        encoder_index_count: 0,
     }
 }
 
@@ -295,13 +296,25 @@ fn calibration_measures_offsets_and_aligns_the_encoder() {
     assert!((999..=1002).contains(&off_calls), "{off_calls}");
     assert!((9_998..=10_001).contains(&on_calls), "{on_calls}");
     assert_eq!(c.current_offsets(), [2060.0, 2040.0, 2051.0]);
-    // θ_e of count 1234 with 4 pole pairs: 4·2π·0.1234 = 3.1013 rad.
-    let want = 4.0 * core::f32::consts::TAU * 0.1234;
+    // The board's counter started wherever it powered up: the alignment's offset is in
+    // the counter's frame, and the table keeps its index-relative value until the index.
+    assert_eq!(c.encoder_offset(), 0.0);
+    assert_eq!(c.encoder_index_count(), None);
+    // The index passes at counter 234 (captured), the counter now reads 240: the rotor's
+    // d axis sat 1234 − 234 = 1000 counts after the index, θ_e = 4·2π·0.1 = 2.5133 rad.
+    c.on_current_sample(&Measurements {
+        encoder_index: true,
+        encoder_index_count: 234,
+        ..healthy(240)
+    });
+    assert_eq!(c.encoder_index_count(), Some(234));
+    let want = 4.0 * core::f32::consts::TAU * 0.1;
     assert!(
         (c.encoder_offset() - want).abs() < 1e-4,
         "{}",
         c.encoder_offset()
     );
+    assert_eq!(c.parameter(ParamId::EncoderOffset), c.encoder_offset());
 }
 
 #[test]
@@ -387,6 +400,7 @@ fn arbitrary_inputs_and_commands_never_panic_and_keep_the_outputs_sane() {
                 adc_pressure: around(&mut rng, pressure_counts(5e6), 2000),
                 encoder_count: count,
                 encoder_index: count < 7 && r % 2 == 0,
+                encoder_index_count: 0,
             };
             let out = c.on_current_sample(&m);
             for d in out.duties {
