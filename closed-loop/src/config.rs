@@ -22,6 +22,9 @@ pub fn controller_config(rig: &Rig) -> Config {
     c.sensors.encoder_offset_rad = s.encoder.offset_rad as f32;
     // The simulated encoder reads ⌊θ/2π·N⌋ from the start: its count 0 is the index.
     c.sensors.encoder_referenced_at_start = true;
+    // The simulated current sensors' offset is an effect under study: the controller keeps
+    // the configured zero until a Calibrating run measures it.
+    c.calibration.offsets_at_boot = false;
     let m = &rig.motor;
     c.motor.pole_pairs = m.pole_pairs;
     c.motor.stator_resistance_ohm = m.r_s_ohm as f32;

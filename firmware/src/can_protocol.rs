@@ -87,7 +87,10 @@
 //! blocks it, `0` for a mode change that must go through disabled), `6` unknown function
 //! (bound = `0`), `7` value not acceptable for another reason (for a parameter: not a
 //! number, not whole, or in conflict with another parameter; bound = `0`), `8` unknown
-//! parameter id or step-test loop code (bound = `0`, byte 6 = the offending code).
+//! parameter id or step-test loop code (bound = `0`, byte 6 = the offending code), `9`
+//! mode refused because the drive is not ready for it yet (bound = `1`: the phase-current
+//! offsets are still being measured after power-up; `2`: the rotor angle is unknown, no
+//! encoder index and no alignment since power-up — see `docs/bring-up.md`).
 //!
 //! # Parameter (`0x1A0 + node`, DLC 8)
 //!
@@ -459,6 +462,9 @@ pub enum RejectReason {
     Invalid,
     /// Unknown parameter id or step-test loop code. Code 8.
     UnknownCode,
+    /// The drive is not ready for the mode yet (the bound says for what: 1 current
+    /// offsets being measured, 2 rotor angle unknown). Code 9.
+    NotReady,
 }
 
 impl RejectReason {
@@ -473,6 +479,7 @@ impl RejectReason {
             RejectReason::UnknownFunction => 6,
             RejectReason::Invalid => 7,
             RejectReason::UnknownCode => 8,
+            RejectReason::NotReady => 9,
         }
     }
 
@@ -487,6 +494,7 @@ impl RejectReason {
             6 => Some(RejectReason::UnknownFunction),
             7 => Some(RejectReason::Invalid),
             8 => Some(RejectReason::UnknownCode),
+            9 => Some(RejectReason::NotReady),
             _ => None,
         }
     }
@@ -578,6 +586,9 @@ impl Rejection {
             | CommandError::Mode(ModeRefusal::ConditionPresent(f))
             | CommandError::CausePresent(f) => (RejectReason::NotAllowed, i32::from(f.code())),
             CommandError::Mode(ModeRefusal::Transition { .. }) => (RejectReason::NotAllowed, 0),
+            CommandError::Mode(ModeRefusal::NotReady(r)) => {
+                (RejectReason::NotReady, i32::from(r.code()))
+            }
             CommandError::Parameter(e) => return Rejection::for_parameter_error(&e),
             CommandError::StepTest(e) => {
                 let (reason, bound) = match e {

@@ -182,6 +182,11 @@ pub struct FaultLimits {
 pub struct CalibrationConfig {
     /// Current-offset averaging time with PWM off. [s]
     pub offset_time_s: f32,
+    /// Measure the phase-current offsets at power-up (bridge off, `offset_time_s`) and
+    /// refuse every active mode until they are. False: `sensors.current_zero_lsb` is
+    /// trusted until a Calibrating run (the simulated sensors, whose offset is an effect
+    /// under study).
+    pub offsets_at_boot: bool,
     /// Largest accepted offset from `current_zero_lsb`. [counts]
     pub offset_max_lsb: f32,
     /// d-axis alignment current. [A]
@@ -340,6 +345,7 @@ impl Config {
             },
             calibration: CalibrationConfig {
                 offset_time_s: 0.05,
+                offsets_at_boot: true,
                 offset_max_lsb: 200.0,
                 alignment_current_a: 5.0,
                 alignment_time_s: 0.5,

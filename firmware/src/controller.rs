@@ -6,11 +6,15 @@
 //! tick) → current loop → fault conditions → supervisor. A fault found in a call returns
 //! disabled PWM from that same call.
 //!
-//! Start-up without calibration: the current offsets start at the configured zero
-//! (`sensors.current_zero_lsb`, mid-scale) and the encoder offset at
-//! `sensors.encoder_offset_rad`, so Speed and Pressure can be entered straight from
-//! Disabled (the simulator does). Calibrating measures both and replaces them; it ends in
-//! Disabled.
+//! Start-up: in Disabled, with the bridge off, the first `calibration.offset_time_s` of
+//! samples measure the phase-current offsets; no active mode is granted before
+//! ([`crate::supervisor::Readiness`]). The encoder offset is the table's
+//! `sensors.encoder_offset_rad`, relative to the index: on an incremental counter Speed
+//! and Pressure wait until the index has been seen (or Calibrating has aligned the rotor)
+//! in this power cycle. A configuration for a counter referenced from the start and
+//! trusted offsets (`sensors.encoder_referenced_at_start`, `calibration.offsets_at_boot`
+//! off: the simulator's) may enter Speed and Pressure straight from Disabled. Calibrating
+//! measures both offsets again and replaces them; it ends in Disabled.
 //!
 //! Parameters ([`Command::SetParameter`]) and step tests ([`Command::StepTest`]) are
 //! applied inside [`Controller::command`], which never runs during a control step: on the
@@ -34,9 +38,10 @@ use crate::pressure_loop::PressureLoop;
 use crate::speed_loop::SpeedLoop;
 use crate::speed_observer::SpeedObserver;
 use crate::step_test::{self, ActiveStep, StepLoop, StepTestError};
-use crate::supervisor::{Conditions, FaultCode, Mode, ModeRefusal, Supervisor};
+use crate::supervisor::{Conditions, FaultCode, Mode, ModeRefusal, Readiness, Supervisor};
 use crate::telemetry::TelemetryFrame;
-use crate::transforms::{wrap_2pi, Dq};
+use crate::transforms::Dq;
+use calibrate::{Calibration, OffsetAverage};
 use core::fmt;
 
 /// A command to the drive (CAN or host).
@@ -117,6 +122,7 @@ impl CommandError {
             CommandError::Mode(ModeRefusal::Faulted(_)) => 3,
             CommandError::Mode(ModeRefusal::ConditionPresent(_)) => 4,
             CommandError::Mode(ModeRefusal::Transition { .. }) => 5,
+            CommandError::Mode(ModeRefusal::NotReady(_)) => 9,
             CommandError::CausePresent(_) => 6,
             CommandError::Parameter(_) => 7,
             CommandError::StepTest(_) => 8,
@@ -144,6 +150,9 @@ impl fmt::Display for CommandError {
             CommandError::Mode(ModeRefusal::Transition { from, to }) => {
                 write!(f, "mode refused: {from:?} -> {to:?} (go through Disabled)")
             }
+            CommandError::Mode(ModeRefusal::NotReady(r)) => {
+                write!(f, "mode refused: not ready, {r}")
+            }
             CommandError::CausePresent(x) => write!(f, "clear refused: cause still present ({x})"),
             CommandError::Parameter(e) => write!(f, "parameter refused: {e}"),
             CommandError::StepTest(StepTestError::WrongMode { required }) => {
@@ -160,13 +169,6 @@ impl fmt::Display for CommandError {
             }
         }
     }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Calibration {
-    Offsets { n: u32, sums: [u32; 3] },
-    Align { n: u32 },
-    Commission,
 }
 
 /// Constants derived once from the configuration.
@@ -210,6 +212,10 @@ pub struct Controller {
     state: CurrentLoopState,
     command_status: u8,
     calibrated: bool,
+    /// The phase-current offsets in use were measured in this power cycle (or the
+    /// configuration trusts its zero: `calibration.offsets_at_boot` off).
+    offsets_measured: bool,
+    boot_offsets: OffsetAverage,
     commissioning: Commissioning,
     commission_requested: bool,
     /// Open-loop voltage commissioning asked for this period. [V]
@@ -264,7 +270,7 @@ impl Controller {
                 }
             },
             sup: Supervisor::new(),
-            calibration: Calibration::Offsets { n: 0, sums: [0; 3] },
+            calibration: Calibration::START,
             active_last_call: false,
             samples: 0,
             speed_tick: 0,
@@ -282,6 +288,8 @@ impl Controller {
             state: CurrentLoopState::default(),
             command_status: 0,
             calibrated: false,
+            offsets_measured: !config.calibration.offsets_at_boot,
+            boot_offsets: OffsetAverage::START,
             commissioning: Commissioning::new(config),
             commission_requested: false,
             open_loop_voltage: None,
@@ -369,6 +377,15 @@ impl Controller {
     /// Fault conditions present in the last sample (latched or not).
     pub fn conditions(&self) -> Conditions {
         self.sup.conditions()
+    }
+
+    /// What the drive is ready for: the current offsets measured since power-up, the rotor
+    /// angle known (encoder index seen or alignment run in this power cycle).
+    pub fn readiness(&self) -> Readiness {
+        Readiness {
+            current_offsets: self.offsets_measured,
+            rotor_angle: self.encoder.angle_known(),
+        }
     }
 
     /// True once a calibration has completed.
@@ -507,7 +524,11 @@ impl Controller {
                     conditions.set(f, true);
                 }
             }
-            Mode::Disabled => {}
+            Mode::Disabled => {
+                if !self.offsets_measured {
+                    self.measure_boot_offsets(m);
+                }
+            }
         }
 
         let omega_e = if self.forced_frame {
@@ -604,62 +625,7 @@ impl Controller {
                 .set_target(self.pressure_target.unwrap_or(self.p_pa));
         }
         if mode == Mode::Calibrating {
-            self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
-        }
-    }
-
-    /// One calibration sample: returns (bridge on, electrical angle to use, fault found).
-    fn calibrate(&mut self, m: &Measurements) -> (bool, f32, Option<FaultCode>) {
-        match self.calibration {
-            Calibration::Offsets { n, sums } => {
-                let mut sums = sums;
-                for (s, a) in sums.iter_mut().zip(m.adc_phase_current) {
-                    *s = s.saturating_add(a as u32);
-                }
-                let n = n + 1;
-                if n >= self.d.offset_calls {
-                    let offsets = sums.map(|s| s as f32 / n as f32);
-                    let zero = self.cfg.sensors.current_zero_lsb;
-                    let bad = offsets
-                        .iter()
-                        .any(|o| (o - zero).abs() > self.cfg.calibration.offset_max_lsb);
-                    if bad {
-                        return (false, 0.0, Some(FaultCode::CurrentOffset));
-                    }
-                    self.current.set_offsets(offsets);
-                    self.current.reset();
-                    self.calibration = if self.commission_requested {
-                        self.commissioning.start();
-                        Calibration::Commission
-                    } else {
-                        Calibration::Align { n: 0 }
-                    };
-                } else {
-                    self.calibration = Calibration::Offsets { n, sums };
-                }
-                (false, 0.0, None)
-            }
-            Calibration::Align { n } => {
-                self.id_ref = self.cfg.calibration.alignment_current_a;
-                self.iq_ref = 0.0;
-                let n = n + 1;
-                if n >= self.d.align_calls {
-                    // The rotor's d axis now sits at θ_e = 0: the count's electrical angle
-                    // is the offset.
-                    let raw = self.encoder.raw_electrical_angle(m.encoder_count);
-                    self.encoder.align(wrap_2pi(raw));
-                    self.take_learned_encoder_offset();
-                    self.calibrated = true;
-                    self.id_ref = 0.0;
-                    self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
-                    // Disabled is always granted.
-                    let _ = self.sup.request(Mode::Disabled);
-                    return (false, 0.0, None);
-                }
-                self.calibration = Calibration::Align { n };
-                (true, 0.0, None)
-            }
-            Calibration::Commission => self.commission_step(m),
+            self.calibration = Calibration::START;
         }
     }
 
@@ -740,6 +706,7 @@ impl Controller {
             }
             Command::SetMode(mode) => {
                 let from = self.sup.mode();
+                self.sup.set_readiness(self.readiness());
                 self.sup.request(mode).map_err(CommandError::Mode)?;
                 if from != mode && mode == Mode::Pressure && from == Mode::Speed {
                     // Bumpless hand-over: the pressure loop starts from the present speed
@@ -749,7 +716,7 @@ impl Controller {
                         .set_target(self.pressure_target.unwrap_or(self.p_pa));
                 }
                 if from != mode && mode == Mode::Calibrating {
-                    self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
+                    self.calibration = Calibration::START;
                 }
                 self.commission_requested = false;
                 Ok(())
@@ -890,6 +857,7 @@ impl Controller {
     }
 }
 
+mod calibrate;
 mod commission;
 #[cfg(test)]
 mod tests;

@@ -36,5 +36,5 @@ pub mod transforms;
 pub use config::{Config, ConfigError};
 pub use controller::{Command, CommandError, Controller};
 pub use io::{Measurements, Outputs};
-pub use supervisor::{FaultCode, Mode};
+pub use supervisor::{FaultCode, Mode, NotReady, Readiness};
 pub use telemetry::TelemetryFrame;

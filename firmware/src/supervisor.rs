@@ -11,6 +11,11 @@
 //! latch only while the bridge is on (Calibrating, Speed, Pressure): a drive at rest with
 //! the DC link off is not faulted, and entering an active mode is refused while any
 //! condition is present.
+//!
+//! Entering an active mode also needs the drive to be ready ([`Readiness`]): the phase-
+//! current offsets measured since power-up (every active mode), and the rotor angle known
+//! — the encoder tied to its index, or an alignment run — in this power cycle (Speed and
+//! Pressure; Calibrating is how the angle is found).
 
 use core::fmt;
 
@@ -218,12 +223,78 @@ impl Conditions {
     }
 }
 
+/// What an active mode waits for besides the absence of faults.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Readiness {
+    /// The phase-current offsets have been measured since power-up.
+    pub current_offsets: bool,
+    /// The electrical angle is known: the encoder is tied to its index, or an alignment
+    /// ran, in this power cycle.
+    pub rotor_angle: bool,
+}
+
+impl Readiness {
+    /// Nothing to wait for.
+    pub const READY: Readiness = Readiness {
+        current_offsets: true,
+        rotor_angle: true,
+    };
+
+    /// What `mode` still waits for, if anything.
+    pub fn missing_for(self, mode: Mode) -> Option<NotReady> {
+        if mode.is_active() && !self.current_offsets {
+            Some(NotReady::CurrentOffsets)
+        } else if matches!(mode, Mode::Speed | Mode::Pressure) && !self.rotor_angle {
+            Some(NotReady::RotorAngle)
+        } else {
+            None
+        }
+    }
+}
+
+impl Default for Readiness {
+    fn default() -> Self {
+        Readiness::READY
+    }
+}
+
+/// Why a drive is not ready for a mode (the wire code in brackets).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum NotReady {
+    /// The phase-current offsets are still being measured (bridge off, for
+    /// `calibration.offset_time_s` after power-up). (1)
+    CurrentOffsets = 1,
+    /// No encoder index since power-up and no alignment: the electrical angle is unknown.
+    /// Turn the shaft past the index, or run Calibrating. (2)
+    RotorAngle = 2,
+}
+
+impl NotReady {
+    /// Wire code.
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+}
+
+impl fmt::Display for NotReady {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            NotReady::CurrentOffsets => "current offsets not measured yet",
+            NotReady::RotorAngle => {
+                "rotor angle unknown (no encoder index and no alignment since power-up)"
+            }
+        })
+    }
+}
+
 /// Mode and latched-fault state.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Supervisor {
     mode: Mode,
     fault: Option<FaultCode>,
     present: Conditions,
+    readiness: Readiness,
 }
 
 impl Supervisor {
@@ -268,6 +339,16 @@ impl Supervisor {
         self.mode = Mode::Disabled;
     }
 
+    /// Sets what the drive is ready for (the controller's measurements of this power cycle).
+    pub fn set_readiness(&mut self, readiness: Readiness) {
+        self.readiness = readiness;
+    }
+
+    /// What the drive is ready for.
+    pub fn readiness(&self) -> Readiness {
+        self.readiness
+    }
+
     /// Clears the latched fault if its cause is gone (event faults: always). On refusal,
     /// returns the fault whose cause is still present.
     pub fn clear(&mut self) -> Result<(), FaultCode> {
@@ -280,9 +361,9 @@ impl Supervisor {
         }
     }
 
-    /// Requests `mode`. Disabled is always granted; an active mode needs no latched fault
-    /// and no present condition; Calibrating is entered only from Disabled; Speed and
-    /// Pressure switch between each other directly.
+    /// Requests `mode`. Disabled is always granted; an active mode needs no latched fault,
+    /// no present condition and the drive ready for it ([`Readiness`]); Calibrating is
+    /// entered only from Disabled; Speed and Pressure switch between each other directly.
     pub fn request(&mut self, mode: Mode) -> Result<(), ModeRefusal> {
         if mode == Mode::Disabled {
             self.mode = mode;
@@ -293,6 +374,9 @@ impl Supervisor {
         }
         if let Some(f) = self.present.first() {
             return Err(ModeRefusal::ConditionPresent(f));
+        }
+        if let Some(r) = self.readiness.missing_for(mode) {
+            return Err(ModeRefusal::NotReady(r));
         }
         let ok = matches!(
             (self.mode, mode),
@@ -319,6 +403,8 @@ pub enum ModeRefusal {
     Faulted(FaultCode),
     /// A fault condition is present now.
     ConditionPresent(FaultCode),
+    /// The drive is not ready for the mode yet.
+    NotReady(NotReady),
     /// The transition is not allowed (go through Disabled).
     Transition {
         /// Current mode.
@@ -406,6 +492,47 @@ mod tests {
         assert_eq!(
             s.request(Mode::Speed),
             Err(ModeRefusal::ConditionPresent(FaultCode::DcLinkUnderVoltage))
+        );
+    }
+
+    #[test]
+    fn active_modes_wait_for_offsets_and_speed_and_pressure_for_the_angle() {
+        let mut s = Supervisor::new();
+        s.set_readiness(Readiness {
+            current_offsets: false,
+            rotor_angle: false,
+        });
+        for m in [Mode::Calibrating, Mode::Speed, Mode::Pressure] {
+            assert_eq!(
+                s.request(m),
+                Err(ModeRefusal::NotReady(NotReady::CurrentOffsets))
+            );
+        }
+        assert_eq!(s.request(Mode::Disabled), Ok(()));
+        s.set_readiness(Readiness {
+            current_offsets: true,
+            rotor_angle: false,
+        });
+        for m in [Mode::Speed, Mode::Pressure] {
+            assert_eq!(
+                s.request(m),
+                Err(ModeRefusal::NotReady(NotReady::RotorAngle))
+            );
+        }
+        // Calibrating is how the angle is found.
+        assert_eq!(s.request(Mode::Calibrating), Ok(()));
+        s.request(Mode::Disabled).unwrap();
+        s.set_readiness(Readiness::READY);
+        assert_eq!(s.request(Mode::Pressure), Ok(()));
+        // A latched fault is named before readiness.
+        s.set_readiness(Readiness {
+            current_offsets: false,
+            rotor_angle: false,
+        });
+        s.trip(FaultCode::Watchdog);
+        assert_eq!(
+            s.request(Mode::Speed),
+            Err(ModeRefusal::Faulted(FaultCode::Watchdog))
         );
     }
 }

@@ -2,7 +2,7 @@
 //! and every malformed frame refused with its reason.
 
 use super::*;
-use crate::supervisor::FaultCode;
+use crate::supervisor::{FaultCode, NotReady};
 
 fn node(n: u8) -> NodeId {
     NodeId::new(n).expect("valid node")
@@ -183,7 +183,7 @@ fn reject_layout_and_round_trip() {
     assert_eq!(f.id(), 0x190);
     assert_eq!(f.payload(), &[0x11, 2, 0x00, 0x24, 0xF4, 0x00, 0, 0]);
     assert_eq!(decode_reply(&f, node(0)), Ok(Reply::Reject(r)));
-    for code in 1..=7 {
+    for code in 1..=9 {
         let reason = RejectReason::from_code(code).unwrap();
         assert_eq!(reason.code(), code);
     }
@@ -198,10 +198,10 @@ fn malformed_replies_are_rejected() {
     ));
     assert_eq!(
         decode_reply(
-            &Frame::new(0x191, &[0x11, 9, 0, 0, 0, 0, 0, 0]).unwrap(),
+            &Frame::new(0x191, &[0x11, 10, 0, 0, 0, 0, 0, 0]).unwrap(),
             me
         ),
-        Err(DecodeError::UnknownReason { code: 9 })
+        Err(DecodeError::UnknownReason { code: 10 })
     );
     assert_eq!(
         decode_reply(
@@ -285,6 +285,15 @@ fn refusals_name_the_violated_bound() {
         (r.function, r.reason, r.bound),
         (0x10, RejectReason::NotAllowed, 0)
     );
+    // Not ready: reason 9, bound 2 for an unknown rotor angle (module documentation).
+    let not_ready = CommandError::Mode(ModeRefusal::NotReady(NotReady::RotorAngle));
+    let r = Rejection::for_command_error(&Request::SetMode(Mode::Speed), &not_ready);
+    assert_eq!(
+        (r.function, r.reason, r.bound),
+        (0x10, RejectReason::NotReady, 2)
+    );
+    let f = encode_reply(&Reply::Reject(r), node(0));
+    assert_eq!(f.payload()[..3], [0x10, 9, 2]);
 }
 
 #[test]

@@ -106,6 +106,6 @@ impl Controller {
         self.forced_frame = false;
         self.id_ref = 0.0;
         self.iq_ref = 0.0;
-        self.calibration = Calibration::Offsets { n: 0, sums: [0; 3] };
+        self.calibration = Calibration::START;
     }
 }

@@ -1,7 +1,9 @@
-//! Façade tests: start-up, each fault's latch/disable/clear cycle, command refusals,
-//! calibration. Sensor values are built from the nominal scaling written out here.
+//! Façade tests: start-up (the board's power-up measurements and the encoder's reference),
+//! each fault's latch/disable/clear cycle, command refusals, calibration. Sensor values are
+//! built from the nominal scaling written out here.
 
 use super::*;
+use crate::supervisor::NotReady;
 
 const A_PER_LSB: f32 = 100.0 / 4096.0;
 const PA_PER_LSB: f32 = 25e6 / 52428.8;
@@ -22,12 +24,37 @@ fn healthy(count: u32) -> Measurements {
     }
 }
 
+/// An index pulse captured at counter `count`, the counter still there.
+fn index_at(count: u32) -> Measurements {
+    Measurements {
+        encoder_index: true,
+        encoder_index_count: count,
+        ..healthy(count)
+    }
+}
+
+/// Power samples of the nominal configuration's offset measurement (0.05 s at 20 kHz).
+const BOOT_CALLS: usize = 1000;
+
+/// A board's power-up: the offset measurement at rest with the bridge off, then the shaft
+/// turned past the encoder index (captured at counter 0).
+fn boot(c: &mut Controller) {
+    for _ in 0..BOOT_CALLS {
+        c.on_current_sample(&healthy(0));
+    }
+    c.on_current_sample(&index_at(0));
+    assert_eq!(c.readiness(), Readiness::READY);
+}
+
 fn running(mode: Mode) -> Controller {
     let mut c = Controller::new(&Config::nominal());
-    c.on_current_sample(&healthy(0));
+    boot(&mut c);
     c.command(Command::SetMode(mode)).unwrap();
     let out = c.on_current_sample(&healthy(0));
-    assert!(out.pwm_enabled, "{mode:?} should start without calibration");
+    assert!(
+        out.pwm_enabled,
+        "{mode:?} should start after the power-up checks"
+    );
     assert_eq!(c.mode(), mode);
     c
 }
@@ -87,6 +114,9 @@ fn trips(
     assert_eq!(c.command(Command::ClearFaults), Ok(()));
     assert_eq!(c.fault(), None);
     assert_eq!(c.mode(), Mode::Disabled);
+    // After an encoder fault the counter needs the index again; for the others this is
+    // one more healthy sample.
+    c.on_current_sample(&index_at(good.encoder_count));
     assert_eq!(c.command(Command::SetMode(Mode::Speed)), Ok(()));
     assert!(c.on_current_sample(&good).pwm_enabled);
 }
@@ -271,11 +301,25 @@ fn out_of_range_commands_are_refused_with_their_bound() {
 #[test]
 fn calibration_measures_offsets_and_aligns_the_encoder() {
     let mut c = Controller::new(&Config::nominal());
+    // Power-up offsets, no index yet: Calibrating is allowed, Speed is not.
+    let at_boot = Measurements {
+        adc_phase_current: [2058, 2042, 2050],
+        ..healthy(1234)
+    };
+    for _ in 0..BOOT_CALLS {
+        c.on_current_sample(&at_boot);
+    }
+    assert_eq!(c.current_offsets(), [2058.0, 2042.0, 2050.0]);
+    assert_eq!(
+        c.command(Command::SetMode(Mode::Speed)),
+        Err(CommandError::Mode(ModeRefusal::NotReady(
+            NotReady::RotorAngle
+        )))
+    );
     let m = Measurements {
         adc_phase_current: [2060, 2040, 2051],
         ..healthy(1234)
     };
-    c.on_current_sample(&m);
     c.command(Command::SetMode(Mode::Calibrating)).unwrap();
     // 0.05 s of offsets with the bridge off, then 0.5 s of alignment with it on.
     let mut off_calls = 0;
@@ -297,9 +341,11 @@ fn calibration_measures_offsets_and_aligns_the_encoder() {
     assert!((9_998..=10_001).contains(&on_calls), "{on_calls}");
     assert_eq!(c.current_offsets(), [2060.0, 2040.0, 2051.0]);
     // The board's counter started wherever it powered up: the alignment's offset is in
-    // the counter's frame, and the table keeps its index-relative value until the index.
+    // the counter's frame, and the table keeps its index-relative value until the index;
+    // the angle is known, so Speed may start before the index.
     assert_eq!(c.encoder_offset(), 0.0);
     assert_eq!(c.encoder_index_count(), None);
+    assert_eq!(c.readiness(), Readiness::READY);
     // The index passes at counter 234 (captured), the counter now reads 240: the rotor's
     // d axis sat 1234 − 234 = 1000 counts after the index, θ_e = 4·2π·0.1 = 2.5133 rad.
     c.on_current_sample(&Measurements {
@@ -319,15 +365,32 @@ fn calibration_measures_offsets_and_aligns_the_encoder() {
 
 #[test]
 fn bad_offsets_fault() {
-    let mut c = Controller::new(&Config::nominal());
-    let m = Measurements {
+    let skewed = Measurements {
         adc_phase_current: [2400, 2048, 2048],
         ..healthy(0)
     };
-    c.on_current_sample(&m);
+    // At power-up: 352 counts from mid-scale (limit 200) latches fault 12 with the bridge
+    // never on, and the measurement starts again.
+    let mut c = Controller::new(&Config::nominal());
+    for _ in 0..BOOT_CALLS {
+        assert!(!c.on_current_sample(&skewed).pwm_enabled);
+    }
+    assert_eq!(c.fault(), Some(FaultCode::CurrentOffset));
+    assert!(!c.readiness().current_offsets);
+    // The amplifier comes back: the next measurement passes, the operator clears, it runs.
+    for _ in 0..BOOT_CALLS {
+        c.on_current_sample(&healthy(0));
+    }
+    assert!(c.readiness().current_offsets);
+    assert_eq!(c.command(Command::ClearFaults), Ok(()));
+    c.on_current_sample(&index_at(0));
+    assert_eq!(c.command(Command::SetMode(Mode::Speed)), Ok(()));
+    // In Calibrating the same check.
+    let mut c = running(Mode::Speed);
+    c.command(Command::SetMode(Mode::Disabled)).unwrap();
     c.command(Command::SetMode(Mode::Calibrating)).unwrap();
     for _ in 0..2000 {
-        c.on_current_sample(&m);
+        c.on_current_sample(&skewed);
         c.command(Command::Heartbeat).unwrap();
     }
     assert_eq!(c.fault(), Some(FaultCode::CurrentOffset));
@@ -341,8 +404,9 @@ fn telemetry_reports_what_the_controller_sees() {
         c.on_current_sample(&healthy(0));
     }
     let t = c.telemetry();
-    // 202 samples taken; the frame is stamped with the last one's instant, the first at 0.
-    assert!((t.t_s - 201.0 / 20e3).abs() < 1e-9, "{}", t.t_s);
+    // 1001 power-up samples, then 201: the frame is stamped with the last one's instant,
+    // the first at 0.
+    assert!((t.t_s - 1201.0 / 20e3).abs() < 1e-9, "{}", t.t_s);
     assert!((t.p_pa - 3e6).abs() < PA_PER_LSB);
     assert!((t.udc_v - 280.0).abs() < 1e-3);
     assert_eq!(t.mode, Mode::Pressure);
@@ -466,5 +530,92 @@ fn an_unvalidated_configuration_does_not_panic() {
             assert!((0.0..=1.0).contains(&d), "call {k}: duty {d}");
         }
         let _ = c.telemetry();
+    }
+}
+
+/// ADC counts of the phase currents for (`i_d`, `i_q`) [A] at `theta_e` [rad]: the
+/// amplitude-invariant inverse Park and Clarke written out, at the nominal 100 A / 4096.
+fn adc_for_dq(i_d: f32, i_q: f32, theta_e: f32) -> [u16; 3] {
+    let tau3 = core::f32::consts::TAU / 3.0;
+    [0.0, -tau3, tau3].map(|shift| {
+        let th = theta_e + shift;
+        let i = i_d * libm::cosf(th) - i_q * libm::sinf(th);
+        libm::roundf(2048.0 + i / A_PER_LSB) as u16
+    })
+}
+
+#[test]
+fn a_board_waits_for_its_offsets_and_the_index_then_commutes_at_the_true_angle() {
+    const N: u32 = 10_000;
+    let mut rng = 0x6b43_a9b5u32;
+    for case in 0..20 {
+        // The encoder disk has its index at disk count 0; the counter started at
+        // `boot_disk`. The table holds the rotor's offset from the index.
+        let boot_disk = next(&mut rng) % N;
+        let offset = (next(&mut rng) % 6283) as f32 * 1e-3;
+        let counter = |disk: u32| (disk + N - boot_disk) % N;
+        let mut cfg = Config::nominal();
+        cfg.sensors.encoder_offset_rad = offset;
+        let mut c = Controller::new(&cfg);
+        c.on_current_sample(&healthy(0));
+        for mode in [Mode::Calibrating, Mode::Speed, Mode::Pressure] {
+            assert_eq!(
+                c.command(Command::SetMode(mode)),
+                Err(CommandError::Mode(ModeRefusal::NotReady(
+                    NotReady::CurrentOffsets
+                ))),
+                "case {case}"
+            );
+            assert_eq!(c.telemetry().command_status, 9);
+        }
+        for _ in 1..BOOT_CALLS {
+            assert!(!c.on_current_sample(&healthy(0)).pwm_enabled);
+        }
+        assert!(c.readiness().current_offsets, "case {case}");
+        for mode in [Mode::Speed, Mode::Pressure] {
+            assert_eq!(
+                c.command(Command::SetMode(mode)),
+                Err(CommandError::Mode(ModeRefusal::NotReady(
+                    NotReady::RotorAngle
+                ))),
+                "case {case}"
+            );
+        }
+        // Turn forwards by hand, 7 counts per period, until the index passes.
+        let mut disk = boot_disk;
+        loop {
+            let next_disk = disk + 7;
+            let index = next_disk % N < disk % N;
+            disk = next_disk;
+            c.on_current_sample(&Measurements {
+                encoder_index: index,
+                encoder_index_count: counter(0),
+                ..healthy(counter(disk % N))
+            });
+            if index {
+                break;
+            }
+        }
+        assert_eq!(c.encoder_index_count(), Some(counter(0)), "case {case}");
+        assert_eq!(c.command(Command::SetMode(Mode::Speed)), Ok(()));
+        // 10 A on the q axis at the true electrical angle reads as i_q = 10 A, i_d = 0: the
+        // current loop's Park uses the rotor's angle, wherever the counter started.
+        let d = disk % N;
+        let theta_e = 4.0 * core::f32::consts::TAU * d as f32 / N as f32 - offset;
+        let out = c.on_current_sample(&Measurements {
+            adc_phase_current: adc_for_dq(0.0, 10.0, theta_e),
+            ..healthy(counter(d))
+        });
+        assert!(out.pwm_enabled);
+        let t = c.telemetry();
+        assert!(
+            (t.iq_a - 10.0).abs() < 0.1 && t.id_a.abs() < 0.1,
+            "case {case}: i_d {} i_q {}",
+            t.id_a,
+            t.iq_a
+        );
+        // The logged shaft angle is the angle from the index.
+        let theta_m = core::f32::consts::TAU * d as f32 / N as f32;
+        assert!((t.theta_m_rad - theta_m).abs() < 1e-4, "case {case}");
     }
 }
