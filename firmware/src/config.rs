@@ -39,6 +39,11 @@ pub struct SensorScaling {
     pub current_a_per_lsb: f32,
     /// Phase-current ADC result at 0 A before calibration (mid-scale). [counts]
     pub current_zero_lsb: f32,
+    /// Shortest low-side conduction before the sampling instant for a valid low-side
+    /// shunt reading: dead time, switching ringing, amplifier settling and ADC sampling
+    /// ([`crate::shunt`]). Sets the largest readable duty 1 − 2·t·f_PWM; at most 1/4 of a
+    /// PWM period. [s]
+    pub shunt_settling_s: f32,
     /// DC-link voltage LSB (0 counts = 0 V). [V/count]
     pub dc_link_v_per_lsb: f32,
     /// Pressure LSB of the 16-bit oversampled result. [Pa/count]
@@ -284,6 +289,7 @@ impl Config {
             sensors: SensorScaling {
                 current_a_per_lsb: 100.0 / 4096.0,
                 current_zero_lsb: 2048.0,
+                shunt_settling_s: 2e-6,
                 dc_link_v_per_lsb: 0.1,
                 pressure_pa_per_lsb: 25e6 / 52428.8,
                 pressure_zero_lsb: 6554.0,
@@ -399,6 +405,13 @@ impl Config {
         positive("sensors.current_a_per_lsb", s.current_a_per_lsb)?;
         if !(s.current_zero_lsb.is_finite() && (0.0..=4095.0).contains(&s.current_zero_lsb)) {
             return Err(err("sensors.current_zero_lsb", "must be within 0..=4095"));
+        }
+        non_negative("sensors.shunt_settling_s", s.shunt_settling_s)?;
+        if crate::shunt::max_sampled_duty(s.shunt_settling_s, r.pwm_hz) < 0.5 {
+            return Err(err(
+                "sensors.shunt_settling_s",
+                "must be at most a quarter of the PWM period",
+            ));
         }
         positive("sensors.dc_link_v_per_lsb", s.dc_link_v_per_lsb)?;
         positive("sensors.pressure_pa_per_lsb", s.pressure_pa_per_lsb)?;
@@ -598,7 +611,12 @@ mod tests {
     #[test]
     fn each_bad_field_is_named() {
         type Case = (fn(&mut Config), &'static str);
-        let cases: [Case; 19] = [
+        let cases: [Case; 20] = [
+            // 15 µs of a 50 µs period: the largest readable duty would be 0.4.
+            (
+                |c| c.sensors.shunt_settling_s = 15e-6,
+                "sensors.shunt_settling_s",
+            ),
             // 0.8 × the 45 A over-current trip is 36 A.
             (
                 |c| c.commissioning.current_a = 40.0,

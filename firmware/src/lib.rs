@@ -25,6 +25,7 @@ pub mod parameters;
 pub mod pi;
 pub mod pressure_loop;
 pub mod scaling;
+pub mod shunt;
 pub mod speed_loop;
 pub mod speed_observer;
 pub mod step_test;

@@ -11,6 +11,21 @@
 //! U_dc/√3 (161.6 V at 280 V, the Table 1 voltage limit). Beyond the hexagon the vector is
 //! scaled down onto it, keeping its angle, so the current loop sees the best voltage in the
 //! commanded direction. Duties are in [0, 1] by construction and clamped against rounding.
+//!
+//! # Three-shunt sampling window ([`modulate_sampled`])
+//!
+//! Low-side shunts read a phase's current only while its low-side switch conducts around
+//! the sampling instant (the counter peak): a duty d leaves (1 − d)/(2·f_PWM) of low-side
+//! conduction before the sample, which must cover the dead time, the switching ringing,
+//! the amplifier's settling and the ADC's sampling ([`crate::shunt`]). With a largest
+//! readable duty w, at most one phase may be above w: its current is rebuilt from the other
+//! two. So the middle duty is kept at or below w — first by moving the zero sequence down
+//! (all duties by the same amount, which changes no phase-to-phase voltage; possible while
+//! the lowest duty stays ≥ 0, i.e. while `(v_mid − v_min)/U_dc ≤ w`), and only beyond that
+//! by scaling the vector down, keeping its angle. Inside the linear circle
+//! `v_mid − v_min ≤ (√3/2)·U_dc`, so for w ≥ √3/2 ≈ 0.866 no command up to the Table 1 limit
+//! loses any voltage; the shift happens only where the middle duty would pass w, so the
+//! centred pattern is kept everywhere else.
 
 use crate::transforms::{inverse_clarke, AlphaBeta};
 
@@ -23,17 +38,29 @@ pub struct Modulation {
     pub limited: bool,
     /// The α-β voltage the duties realise (the command, or its limited version). [V]
     pub applied: AlphaBeta,
+    /// The phase (0‥2) whose duty is above the sampling window, if any
+    /// ([`modulate_sampled`]; never with [`modulate`]).
+    pub above_window: Option<u8>,
 }
 
 /// Duties for the α-β voltage `v` [V] from the DC link `u_dc` [V]. A DC link below 1 V
 /// gives 50 % on all phases (zero voltage).
 #[inline]
 pub fn modulate(v: AlphaBeta, u_dc: f32) -> Modulation {
+    modulate_sampled(v, u_dc, 1.0)
+}
+
+/// As [`modulate`], with at most one duty above `max_sampled_duty` (the largest duty whose
+/// low-side shunt can still be read, see the module documentation); `1.0` is [`modulate`].
+/// Always inlined (it is the current loop's hot path), its rare branch never.
+#[inline(always)]
+pub fn modulate_sampled(v: AlphaBeta, u_dc: f32, max_sampled_duty: f32) -> Modulation {
     if u_dc.is_nan() || u_dc < 1.0 || !(v.alpha.is_finite() && v.beta.is_finite()) {
         return Modulation {
             duties: [0.5; 3],
             limited: true,
             applied: AlphaBeta::default(),
+            above_window: None,
         };
     }
     let [a, b, c] = inverse_clarke(v);
@@ -42,14 +69,23 @@ pub fn modulate(v: AlphaBeta, u_dc: f32) -> Modulation {
     let max = if c > hi_ab { c } else { hi_ab };
     let min = if c < lo_ab { c } else { lo_ab };
     let span = max - min;
-    let (scale, limited) = if span > u_dc {
+    let (mut scale, mut limited) = if span > u_dc {
         (u_dc / span, true)
     } else {
         (1.0, false)
     };
-    let k = scale / u_dc;
+    let mut k = scale / u_dc;
     let zero = -0.5 * (max + min);
-    let duty = |x: f32| (0.5 + (x + zero) * k).clamp(0.0, 1.0);
+    // The highest duty is 1/2 + span·k/2: at or below the window (the usual case) the
+    // middle one is too, and nothing moves.
+    let mut base = 0.5;
+    let mut above_window = None;
+    if span * k > 2.0 * max_sampled_duty - 1.0 {
+        (k, base, limited, above_window) =
+            keep_middle_readable([a, b, c], max, min, zero, k, max_sampled_duty, limited);
+        scale = k * u_dc;
+    }
+    let duty = |x: f32| (base + (x + zero) * k).clamp(0.0, 1.0);
     Modulation {
         duties: [duty(a), duty(b), duty(c)],
         limited,
@@ -57,7 +93,47 @@ pub fn modulate(v: AlphaBeta, u_dc: f32) -> Modulation {
             alpha: v.alpha * scale,
             beta: v.beta * scale,
         },
+        above_window,
     }
+}
+
+/// The highest duty is above the window `w`: returns the volts-to-duty factor, the duty
+/// of zero voltage (1/2 less the zero-sequence shift), whether the vector was limited,
+/// and the phase still above the window, so that the middle duty is at most `w` (see the
+/// module documentation). `v` are the phase voltages, `max`, `min` the highest and lowest
+/// of them, `zero` the centring offset [V], `k` the factor so far [1/V].
+#[cold]
+#[inline(never)]
+fn keep_middle_readable(
+    v: [f32; 3],
+    max: f32,
+    min: f32,
+    zero: f32,
+    k: f32,
+    w: f32,
+    limited: bool,
+) -> (f32, f32, bool, Option<u8>) {
+    // The phase voltages sum to zero.
+    let mid = -(max + min);
+    let (k, limited) = if (mid - min) * k > w {
+        (w / (mid - min), true)
+    } else {
+        (k, limited)
+    };
+    let d_mid = 0.5 + (mid + zero) * k;
+    let shift = if d_mid > w { d_mid - w } else { 0.0 };
+    let base = 0.5 - shift;
+    let above = (base + (max + zero) * k > w).then(|| {
+        let [a, b, _] = v;
+        if max == a {
+            0
+        } else if max == b {
+            1
+        } else {
+            2
+        }
+    });
+    (k, base, limited, above)
 }
 
 #[cfg(test)]
@@ -160,6 +236,79 @@ mod tests {
             let max = m.duties.iter().cloned().fold(0.0, f32::max);
             let min = m.duties.iter().cloned().fold(1.0, f32::min);
             assert!((max - 1.0).abs() < 1e-5 && min.abs() < 1e-5);
+        }
+    }
+
+    /// Sorted duties, lowest first.
+    fn sorted(d: [f32; 3]) -> [f32; 3] {
+        let mut d = d;
+        d.sort_by(|x, y| x.total_cmp(y));
+        d
+    }
+
+    #[test]
+    fn the_sampling_window_keeps_the_middle_duty_readable_without_losing_voltage() {
+        // w = 0.92: 2 µs of low-side conduction before the sample at 20 kHz. Up to the
+        // linear circle (Table 1's 161.6 V) every command is realised exactly, and at most
+        // one duty is above w.
+        let u_dc = 280.0;
+        let w = 0.92;
+        let mut shifted = 0;
+        for k in 0..720 {
+            for r in [0.3, 0.6, 0.9, 0.9999] {
+                let r = r * u_dc / libm::sqrtf(3.0);
+                let phi = k as f32 * PI / 360.0;
+                let v = AlphaBeta {
+                    alpha: r * libm::cosf(phi),
+                    beta: r * libm::sinf(phi),
+                };
+                let m = modulate_sampled(v, u_dc, w);
+                assert!(!m.limited, "{r} V at {phi} rad");
+                let [lo, mid, hi] = sorted(m.duties);
+                assert!(mid <= w + 1e-6 && lo >= 0.0, "{:?}", m.duties);
+                // The phase named above the window is the one with the highest duty.
+                match m.above_window {
+                    Some(p) => assert!(m.duties[p as usize] == hi && hi > w),
+                    None => assert!(hi <= w + 1e-6, "{:?}", m.duties),
+                }
+                let (a, b) = realised(m.duties, u_dc);
+                assert!((a - v.alpha).abs() < 1e-2 && (b - v.beta).abs() < 1e-2);
+                if m.duties != modulate(v, u_dc).duties {
+                    shifted += 1;
+                }
+            }
+        }
+        // Only near the top of the circle's vertex directions does anything move.
+        assert!(shifted > 0 && shifted < 720, "{shifted}");
+        // Inside, where the middle duty is below w anyway, the centred pattern is kept.
+        let v = AlphaBeta {
+            alpha: 40.0,
+            beta: -25.0,
+        };
+        assert_eq!(modulate_sampled(v, u_dc, w), modulate(v, u_dc));
+    }
+
+    #[test]
+    fn a_narrow_window_scales_the_vector_keeping_its_angle() {
+        // w = 0.6 (100 kHz PWM with 2 µs settling): at a vertex direction the two highest
+        // phases are |v|/2 and the lowest −|v| (amplitude-invariant Clarke), 1.5·|v| apart,
+        // so |v| is held to 0.6·U_dc/1.5 = 112 V: a 100 V command passes, 150 V is scaled
+        // to 112 V.
+        let u_dc = 280.0;
+        for (r, want_r, limited) in [(100.0, 100.0, false), (150.0, 112.0, true)] {
+            // 60°: phases a and b equal and highest.
+            let phi = PI / 3.0;
+            let v = AlphaBeta {
+                alpha: r * libm::cosf(phi),
+                beta: r * libm::sinf(phi),
+            };
+            let m = modulate_sampled(v, u_dc, 0.6);
+            assert_eq!(m.limited, limited);
+            let [lo, mid, _] = sorted(m.duties);
+            assert!(mid <= 0.6 + 1e-6 && lo >= -1e-6, "{:?}", m.duties);
+            let (a, b) = realised(m.duties, u_dc);
+            assert!((libm::atan2f(b, a) - phi).abs() < 1e-4);
+            assert!((libm::sqrtf(a * a + b * b) - want_r).abs() < 0.05, "{r}");
         }
     }
 
