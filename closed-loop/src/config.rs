@@ -25,6 +25,8 @@ pub fn controller_config(rig: &Rig) -> Config {
     // The simulated current sensors' offset is an effect under study: the controller keeps
     // the configured zero until a Calibrating run measures it.
     c.calibration.offsets_at_boot = false;
+    // The plant's inverter has ideal switches: no bootstrap supply to charge.
+    c.calibration.bootstrap_precharge_s = 0.0;
     let m = &rig.motor;
     c.motor.pole_pairs = m.pole_pairs;
     c.motor.stator_resistance_ohm = m.r_s_ohm as f32;

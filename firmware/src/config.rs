@@ -196,6 +196,13 @@ pub struct CalibrationConfig {
     pub offset_max_lsb: f32,
     /// d-axis alignment current. [A]
     pub alignment_current_a: f32,
+    /// Bootstrap precharge: each time the bridge comes on, all three low sides conduct for
+    /// this long (zero vector, no current control) before the first high-side pulse, so
+    /// the high-side gate drivers' bootstrap capacitors are charged. 0 for a stage with
+    /// isolated gate supplies (or the simulator's ideal switches); at most 10 ms. On a
+    /// turning shaft the zero vector brakes: the current rises at most at back-EMF / L.
+    /// [s]
+    pub bootstrap_precharge_s: f32,
     /// Alignment time at θ_e = 0 (rotor settles on the d axis). [s]
     pub alignment_time_s: f32,
 }
@@ -354,6 +361,7 @@ impl Config {
                 offsets_at_boot: true,
                 offset_max_lsb: 200.0,
                 alignment_current_a: 5.0,
+                bootstrap_precharge_s: 0.5e-3,
                 alignment_time_s: 0.5,
             },
             commissioning: CommissioningConfig::nominal(),
@@ -578,6 +586,13 @@ impl Config {
                 "must be below limits.over_current_a",
             ));
         }
+        non_negative("calibration.bootstrap_precharge_s", k.bootstrap_precharge_s)?;
+        if k.bootstrap_precharge_s > 10e-3 {
+            return Err(err(
+                "calibration.bootstrap_precharge_s",
+                "must be at most 10 ms",
+            ));
+        }
         positive("calibration.alignment_time_s", k.alignment_time_s)?;
         if k.alignment_time_s > 60.0 {
             return Err(err("calibration.alignment_time_s", "must be at most 60 s"));
@@ -611,7 +626,11 @@ mod tests {
     #[test]
     fn each_bad_field_is_named() {
         type Case = (fn(&mut Config), &'static str);
-        let cases: [Case; 20] = [
+        let cases: [Case; 21] = [
+            (
+                |c| c.calibration.bootstrap_precharge_s = 0.02,
+                "calibration.bootstrap_precharge_s",
+            ),
             // 15 µs of a 50 µs period: the largest readable duty would be 0.4.
             (
                 |c| c.sensors.shunt_settling_s = 15e-6,

@@ -179,6 +179,7 @@ struct Derived {
     pressure_div: u32,
     timeout_calls: u32,
     offset_calls: u32,
+    precharge_calls: u32,
     align_calls: u32,
     pole_pairs: f32,
 }
@@ -216,6 +217,8 @@ pub struct Controller {
     /// configuration trusts its zero: `calibration.offsets_at_boot` off).
     offsets_measured: bool,
     boot_offsets: OffsetAverage,
+    /// Bootstrap-precharge periods left before the bridge's first switching period.
+    precharge_left: u32,
     commissioning: Commissioning,
     commission_requested: bool,
     /// Open-loop voltage commissioning asked for this period. [V]
@@ -232,6 +235,7 @@ impl Controller {
         let r = &config.rates;
         let pwm = r.pwm_hz.max(1.0);
         let calls = |s: f32| ((s * pwm) as u32).max(1);
+        let precharge_calls = (config.calibration.bootstrap_precharge_s * pwm + 0.5) as u32;
         let max_step = max_step_counts(
             config.limits.encoder_plausible_speed_rad_s,
             pwm,
@@ -245,6 +249,7 @@ impl Controller {
                 pressure_div: whole_ratio(pwm, r.pressure_loop_hz).unwrap_or(1),
                 timeout_calls: calls(config.limits.command_timeout_s),
                 offset_calls: calls(config.calibration.offset_time_s),
+                precharge_calls,
                 align_calls: calls(config.calibration.alignment_time_s),
                 pole_pairs: config.motor.pole_pairs as f32,
             },
@@ -290,6 +295,7 @@ impl Controller {
             calibrated: false,
             offsets_measured: !config.calibration.offsets_at_boot,
             boot_offsets: OffsetAverage::START,
+            precharge_left: precharge_calls,
             commissioning: Commissioning::new(config),
             commission_requested: false,
             open_loop_voltage: None,
@@ -536,7 +542,13 @@ impl Controller {
         } else {
             self.speed.speed() * self.d.pole_pairs
         };
-        self.state = if bridge {
+        // The first periods after the bridge comes on charge the high-side gate drivers'
+        // bootstrap capacitors: all three low sides on (zero vector), no current control.
+        let precharging = bridge && self.precharge_left > 0;
+        if precharging {
+            self.open_loop_voltage = None;
+        }
+        self.state = if bridge && !precharging {
             let i_ref = Dq {
                 d: self.id_ref,
                 q: self.iq_ref,
@@ -598,11 +610,22 @@ impl Controller {
         let still_on = self.sup.check(conditions);
         self.active_last_call = self.sup.mode().is_active();
         if still_on && bridge {
-            Outputs {
-                duties: self.state.duties,
-                pwm_enabled: true,
+            if precharging {
+                self.precharge_left -= 1;
+                // The current loop starts from rest after the precharge.
+                self.current.reset();
+                Outputs {
+                    duties: [0.0; 3],
+                    pwm_enabled: true,
+                }
+            } else {
+                Outputs {
+                    duties: self.state.duties,
+                    pwm_enabled: true,
+                }
             }
         } else {
+            self.precharge_left = self.d.precharge_calls;
             if !still_on {
                 self.state.u_dq = Dq::default();
                 self.state.duties = [0.5; 3];

@@ -35,6 +35,8 @@ fn index_at(count: u32) -> Measurements {
 
 /// Power samples of the nominal configuration's offset measurement (0.05 s at 20 kHz).
 const BOOT_CALLS: usize = 1000;
+/// Periods of the nominal bootstrap precharge (0.5 ms at 20 kHz).
+const PRECHARGE_CALLS: usize = 10;
 
 /// A board's power-up: the offset measurement at rest with the bridge off, then the shaft
 /// turned past the encoder index (captured at counter 0).
@@ -598,6 +600,9 @@ fn a_board_waits_for_its_offsets_and_the_index_then_commutes_at_the_true_angle()
         }
         assert_eq!(c.encoder_index_count(), Some(counter(0)), "case {case}");
         assert_eq!(c.command(Command::SetMode(Mode::Speed)), Ok(()));
+        for _ in 0..PRECHARGE_CALLS {
+            c.on_current_sample(&healthy(counter(disk % N)));
+        }
         // 10 A on the q axis at the true electrical angle reads as i_q = 10 A, i_d = 0: the
         // current loop's Park uses the rotor's angle, wherever the counter started.
         let d = disk % N;
@@ -618,4 +623,55 @@ fn a_board_waits_for_its_offsets_and_the_index_then_commutes_at_the_true_angle()
         let theta_m = core::f32::consts::TAU * d as f32 / N as f32;
         assert!((t.theta_m_rad - theta_m).abs() < 1e-4, "case {case}");
     }
+}
+
+#[test]
+fn each_start_of_the_bridge_begins_with_the_bootstrap_precharge() {
+    // 0.5 ms at 20 kHz: ten periods with all low sides on (duty 0 on every phase), then
+    // the current loop, started from rest.
+    let mut c = Controller::new(&Config::nominal());
+    boot(&mut c);
+    let start = |c: &mut Controller, mode: Mode| {
+        c.command(Command::SetMode(mode)).unwrap();
+        for k in 0..PRECHARGE_CALLS {
+            let out = c.on_current_sample(&healthy(0));
+            assert!(out.pwm_enabled, "{mode:?} period {k}");
+            assert_eq!(out.duties, [0.0; 3], "{mode:?} period {k}");
+            assert_eq!(c.telemetry().uq_v, 0.0);
+        }
+        let out = c.on_current_sample(&healthy(0));
+        assert!(out.pwm_enabled);
+        // At rest with zero references the modulator is centred again.
+        for d in out.duties {
+            assert!((d - 0.5).abs() < 0.05, "{:?}", out.duties);
+        }
+    };
+    start(&mut c, Mode::Speed);
+    // Speed to Pressure keeps the bridge on: no second precharge.
+    c.command(Command::SetMode(Mode::Pressure)).unwrap();
+    assert_ne!(c.on_current_sample(&healthy(0)).duties, [0.0; 3]);
+    // After the bridge was off, again.
+    c.command(Command::SetMode(Mode::Disabled)).unwrap();
+    assert!(!c.on_current_sample(&healthy(0)).pwm_enabled);
+    start(&mut c, Mode::Speed);
+    // Calibrating: the offsets with the bridge off first, then the precharge right before
+    // the alignment current.
+    c.command(Command::SetMode(Mode::Disabled)).unwrap();
+    c.on_current_sample(&healthy(0));
+    c.command(Command::SetMode(Mode::Calibrating)).unwrap();
+    for _ in 0..BOOT_CALLS {
+        assert!(!c.on_current_sample(&healthy(0)).pwm_enabled);
+        c.command(Command::Heartbeat).unwrap();
+    }
+    for _ in 0..PRECHARGE_CALLS {
+        assert_eq!(c.on_current_sample(&healthy(0)).duties, [0.0; 3]);
+    }
+    assert_ne!(c.on_current_sample(&healthy(0)).duties, [0.0; 3]);
+    // The simulator's configuration has none.
+    let mut cfg = Config::nominal();
+    cfg.calibration.bootstrap_precharge_s = 0.0;
+    let mut c = Controller::new(&cfg);
+    boot(&mut c);
+    c.command(Command::SetMode(Mode::Speed)).unwrap();
+    assert_ne!(c.on_current_sample(&healthy(0)).duties, [0.0; 3]);
 }
