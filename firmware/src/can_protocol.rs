@@ -798,6 +798,21 @@ pub struct EncodeError {
     pub problem: &'static str,
 }
 
+/// Standard-identifier acceptance filters, as (identifier, mask) pairs (a frame passes when
+/// `id & mask == identifier & mask`), that pass exactly the command blocks of `node`: the
+/// real-time commands `0x100`‥`0x170` and the configuration commands `0x200`‥`0x270` with
+/// its node number. Replies, other nodes' frames and every other identifier stay in the
+/// controller's filter, out of the drive's receive FIFO; a free function code of these
+/// blocks still reaches the drive, which rejects it as unknown.
+pub fn acceptance_filters(node: NodeId) -> [(u16, u16); 2] {
+    // Bits 10..7 select the block, bits 3..0 the node.
+    const MASK: u16 = 0x780 | NODE_MASK;
+    [
+        (node.id(id::SET_MODE), MASK),
+        (node.id(id::SET_PARAMETER), MASK),
+    ]
+}
+
 /// Decodes a command frame addressed to `node`.
 pub fn decode_command(frame: &Frame, node: NodeId) -> Result<Request, DecodeError> {
     let frame_node = (frame.id & NODE_MASK) as u8;

@@ -167,6 +167,11 @@ pub struct Hydraulics {
 pub struct FaultLimits {
     /// Phase over-current trip (any phase, magnitude). [A]
     pub over_current_a: f32,
+    /// Hardware over-current trip: a phase current of this size flowing out of the motor
+    /// terminal through the low-side switch and its shunt (a short or a shoot-through)
+    /// breaks the bridge within the comparator's and the break filter's delay, whatever
+    /// the software does. Above `over_current_a`, within the current sensor's range. [A]
+    pub hardware_over_current_a: f32,
     /// DC-link over-voltage trip. [V]
     pub over_voltage_v: f32,
     /// DC-link under-voltage trip (checked while the bridge is on). [V]
@@ -349,6 +354,7 @@ impl Config {
             },
             limits: FaultLimits {
                 over_current_a: 45.0,
+                hardware_over_current_a: 47.0,
                 over_voltage_v: 360.0,
                 under_voltage_v: 200.0,
                 over_pressure_pa: 20e6,
@@ -524,6 +530,19 @@ impl Config {
         if l.over_current_a <= sp.iq_limit_a {
             return Err(err("limits.over_current_a", "must exceed speed.iq_limit_a"));
         }
+        positive("limits.hardware_over_current_a", l.hardware_over_current_a)?;
+        if l.hardware_over_current_a <= l.over_current_a {
+            return Err(err(
+                "limits.hardware_over_current_a",
+                "must exceed limits.over_current_a",
+            ));
+        }
+        if l.hardware_over_current_a / s.current_a_per_lsb >= s.current_zero_lsb {
+            return Err(err(
+                "limits.hardware_over_current_a",
+                "must be within the current sensor's range below its zero",
+            ));
+        }
         positive("limits.under_voltage_v", l.under_voltage_v)?;
         positive("limits.over_voltage_v", l.over_voltage_v)?;
         if l.under_voltage_v >= l.over_voltage_v {
@@ -626,7 +645,16 @@ mod tests {
     #[test]
     fn each_bad_field_is_named() {
         type Case = (fn(&mut Config), &'static str);
-        let cases: [Case; 21] = [
+        let cases: [Case; 23] = [
+            (
+                |c| c.limits.hardware_over_current_a = 44.0,
+                "limits.hardware_over_current_a",
+            ),
+            // 2048 counts of 0.0244 A: 50 A is the end of the range.
+            (
+                |c| c.limits.hardware_over_current_a = 50.0,
+                "limits.hardware_over_current_a",
+            ),
             (
                 |c| c.calibration.bootstrap_precharge_s = 0.02,
                 "calibration.bootstrap_precharge_s",

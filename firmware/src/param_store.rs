@@ -1,25 +1,27 @@
 //! Persistence of the live parameter table ([`crate::parameters`]) in NOR flash: two
-//! erase pages used alternately (A/B), each holding at most one record with a format
-//! version, a table fingerprint, a sequence number and a CRC-32, completed by a separate
-//! commit word written last.
+//! slots used alternately (A/B), each a whole number of erase pages holding at most one
+//! record with a format version, a table fingerprint, a sequence number and a CRC-32,
+//! completed by a separate commit word written last. The slot length is the caller's
+//! (the board's named constant): one 2 KiB page of the G474's bank 2 holds today's record,
+//! and a larger record (a compensation table) takes more pages per slot without any other
+//! change here.
 //!
 //! Generic over [`embedded_storage::nor_flash::NorFlash`], so the same code runs on the
 //! G474's flash and on a RAM-backed flash in the host tests.
 //!
-//! # Why two pages and a commit word
+//! # Why two slots and a commit word
 //!
-//! A save erases and writes only the page that does *not* hold the newest valid record,
+//! A save erases and writes only the slot that does *not* hold the newest valid record,
 //! so the previous table stays intact until the new one is complete: a power cut at any
 //! point of a save (during the erase, the record, or the commit word; mid-word included)
 //! leaves the old record readable, and the next load returns the old table or the new one,
 //! never a mixture. A record counts only when its CRC matches *and* its commit word is
 //! present; the commit word is written after the record, so a record interrupted after
 //! its last data word but before the commit is not taken either. The sequence number
-//! (newer = larger) decides between two valid pages. Two pages cost 2 erase pages of
-//! flash; a log-structured store (e.g. `sequential-storage`) would level wear, but the
+//! (newer = larger) decides between two valid slots. Two slots cost twice the record's
+//! pages of flash; a log-structured store (e.g. `sequential-storage`) would level wear, but the
 //! table is saved by an operator, a few times in a drive's life, far below the 10 000
-//! erase cycles of the G4's flash, and the A/B scheme is a fraction of the code size
-//! (the firmware budget is 64 KiB).
+//! erase cycles of the G4's flash, and the A/B scheme is a fraction of the code size.
 //!
 //! # Record layout (little endian, from the page start)
 //!
@@ -104,40 +106,53 @@ pub enum LoadOutcome {
 /// Why a store could not be opened or a save failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StoreError<E> {
-    /// The page offsets are not erase-page aligned, overlap, or the flash's programming
-    /// unit does not divide 8 bytes, or a page is smaller than a record.
+    /// The slot offsets are not erase-page aligned, the slot length is not a whole
+    /// number of erase pages or is shorter than a record, the slots overlap or leave the
+    /// flash, or the flash's programming unit does not divide 8 bytes.
     Layout,
     /// The flash driver failed.
     Flash(E),
 }
 
-/// The two pages of the parameter table on a flash.
+/// The two slots of the parameter table on a flash.
 #[derive(Debug)]
 pub struct ParamStore<F> {
     flash: F,
     pages: [u32; 2],
+    slot_len: u32,
 }
 
 impl<F: NorFlash> ParamStore<F> {
-    /// Opens the store on pages at offsets `page_a` and `page_b` of `flash` (offsets as the
-    /// driver counts them, each the start of an erase page).
-    pub fn new(flash: F, page_a: u32, page_b: u32) -> Result<ParamStore<F>, StoreError<F::Error>> {
+    /// Opens the store on two slots of `slot_len` bytes at offsets `slot_a` and `slot_b` of
+    /// `flash` (offsets as the driver counts them, each the start of an erase page; the
+    /// length a whole number of erase pages).
+    pub fn new(
+        flash: F,
+        slot_a: u32,
+        slot_b: u32,
+        slot_len: u32,
+    ) -> Result<ParamStore<F>, StoreError<F::Error>> {
         let erase = F::ERASE_SIZE as u32;
+        let end = |slot: u32| slot.checked_add(slot_len);
         let fits = F::WRITE_SIZE > 0
             && 8 % F::WRITE_SIZE == 0
-            && F::ERASE_SIZE >= SPAN
-            && page_a % erase == 0
-            && page_b % erase == 0
-            && page_a != page_b
-            && [page_a, page_b]
+            && erase > 0
+            && slot_len as usize >= SPAN
+            && slot_len % erase == 0
+            && slot_a % erase == 0
+            && slot_b % erase == 0
+            && [slot_a, slot_b]
                 .iter()
-                .all(|p| (*p as usize).saturating_add(F::ERASE_SIZE) <= flash.capacity());
+                .all(|s| end(*s).is_some_and(|e| e as usize <= flash.capacity()))
+            && (end(slot_a).is_some_and(|e| e <= slot_b)
+                || end(slot_b).is_some_and(|e| e <= slot_a));
         if !fits {
             return Err(StoreError::Layout);
         }
         Ok(ParamStore {
             flash,
-            pages: [page_a, page_b],
+            pages: [slot_a, slot_b],
+            slot_len,
         })
     }
 
@@ -184,7 +199,7 @@ impl<F: NorFlash> ParamStore<F> {
         commit[..4].copy_from_slice(&COMMIT_MAGIC.to_le_bytes());
         commit[4..].copy_from_slice(&sequence.to_le_bytes());
         self.flash
-            .erase(page, page + F::ERASE_SIZE as u32)
+            .erase(page, page + self.slot_len)
             .map_err(StoreError::Flash)?;
         self.flash.write(page, &record).map_err(StoreError::Flash)?;
         self.flash

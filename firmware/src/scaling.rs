@@ -44,6 +44,19 @@ pub fn duty_to_compare(duty: f32, period: u16) -> u16 {
     ((product >> 15) as u16).min(period)
 }
 
+/// The 12-bit code of a threshold that a phase-current reading crosses at `trip_a` [A]
+/// flowing out of the motor terminal (negative in the current convention), for readings
+/// `zero_lsb` [counts] at 0 A and `a_per_lsb` [A/count]: `zero − trip/a_per_lsb`, rounded,
+/// within 0‥4095 (a DAC sharing the ADC's reference compares in the same counts).
+pub fn comparator_threshold_counts(zero_lsb: f32, a_per_lsb: f32, trip_a: f32) -> u16 {
+    let code = libm::roundf(zero_lsb - trip_a / a_per_lsb);
+    if code.is_nan() {
+        0
+    } else {
+        code.clamp(0.0, 4095.0) as u16
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -60,6 +73,23 @@ mod tests {
         // Phase current: fraction of half scale × 50 A (100 A over 4096 counts).
         let i = adc12_bipolar(2048 + 410, 2048).to_num::<f32>() * 50.0;
         assert!((i - 410.0 * 100.0 / 4096.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn comparator_thresholds_sit_below_the_zero_by_the_trip_current() {
+        // 47 A at 100 A / 4096 counts is 1925.12 counts below mid-scale 2048: 123.
+        assert_eq!(
+            comparator_threshold_counts(2048.0, 100.0 / 4096.0, 47.0),
+            123
+        );
+        assert_eq!(
+            comparator_threshold_counts(2048.0, 100.0 / 4096.0, 0.0),
+            2048
+        );
+        // Beyond the converter's range, or nonsense: clamped.
+        assert_eq!(comparator_threshold_counts(2048.0, 100.0 / 4096.0, 60.0), 0);
+        assert_eq!(comparator_threshold_counts(2048.0, 0.0, 1.0), 0);
+        assert_eq!(comparator_threshold_counts(f32::NAN, 1.0, 1.0), 0);
     }
 
     #[test]

@@ -206,7 +206,7 @@ impl ReadNorFlash for RamFlash {
 
 impl NorFlash for RamFlash {
     const WRITE_SIZE: usize = 8;
-    const ERASE_SIZE: usize = 4096;
+    const ERASE_SIZE: usize = 2048;
     fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
         self.0[from as usize..to as usize].fill(0xFF);
         Ok(())
@@ -221,7 +221,7 @@ impl NorFlash for RamFlash {
 #[test]
 fn a_table_set_over_can_and_saved_is_there_after_a_reboot() {
     let mut c = Controller::new(&Config::nominal());
-    let mut store = ParamStore::new(RamFlash(vec![0xFF; 8192]), 0, 4096).expect("store");
+    let mut store = ParamStore::new(RamFlash(vec![0xFF; 4096]), 0, 2048, 2048).expect("store");
     ask(&mut c, &encode_set_parameter(ParamId::SpeedKp, 0.2, node()));
     ask(
         &mut c,

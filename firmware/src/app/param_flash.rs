@@ -48,7 +48,7 @@ pub fn maintenance_windows() -> u32 {
 pub fn open(
     flash: Flash<'static, Blocking>,
 ) -> Result<Store, StoreError<embassy_stm32::flash::Error>> {
-    ParamStore::new(flash, PAGE_A, PAGE_B)
+    ParamStore::new(flash, PAGE_A, PAGE_B, MAX_ERASE_SIZE as u32)
 }
 
 /// Saves `values` with the current loop masked and the watchdog stretched; returns the

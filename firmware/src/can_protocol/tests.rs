@@ -297,6 +297,54 @@ fn refusals_name_the_violated_bound() {
 }
 
 #[test]
+fn acceptance_filters_pass_exactly_this_nodes_commands() {
+    let commands = [
+        0x100, 0x110, 0x120, 0x130, 0x140, 0x200, 0x210, 0x220, 0x230, 0x240,
+    ];
+    for n in 0..=15u8 {
+        let me = node(n);
+        let filters = acceptance_filters(me);
+        let passes = |id: u16| filters.iter().any(|(f, m)| id & m == f & m);
+        for base in commands {
+            assert!(passes(base + u16::from(n)), "{base:#x} node {n}");
+        }
+        let mut passed = 0;
+        for id in 0..=STANDARD_ID_MAX {
+            if !passes(id) {
+                continue;
+            }
+            passed += 1;
+            // Only this node's frames in the two command blocks; never a reply.
+            assert_eq!(id & 0xF, u16::from(n), "{id:#x}");
+            assert!(
+                (0x100..0x180).contains(&id) || (0x200..0x280).contains(&id),
+                "{id:#x}"
+            );
+            assert!(
+                decode_command(&Frame::new(id, &[]).unwrap(), me).is_ok_or_refusable(),
+                "{id:#x}"
+            );
+        }
+        // Eight function slots in each block.
+        assert_eq!(passed, 16);
+    }
+}
+
+trait Refusable {
+    fn is_ok_or_refusable(&self) -> bool;
+}
+
+impl Refusable for Result<Request, DecodeError> {
+    /// Decoded, or refused with a reply (never ignored as another node's or a reply).
+    fn is_ok_or_refusable(&self) -> bool {
+        match self {
+            Ok(_) => true,
+            Err(e) => Rejection::for_decode_error(e).is_some(),
+        }
+    }
+}
+
+#[test]
 fn mode_codes_are_the_four_documented_ones() {
     // 0 disabled, 1 calibrating, 2 speed, 3 pressure (module documentation).
     let documented = [

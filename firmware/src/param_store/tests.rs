@@ -10,8 +10,8 @@ use crate::parameters::ParamId;
 use embedded_storage::nor_flash::{ErrorType, NorFlashError, NorFlashErrorKind, ReadNorFlash};
 use std::vec::Vec;
 
-/// G474 single-bank erase page and programming unit.
-const PAGE: usize = 4096;
+/// G474 dual-bank erase page and programming unit.
+const PAGE: usize = 2048;
 const WORD: usize = 8;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -145,7 +145,13 @@ impl NorFlash for CutFlash {
 }
 
 fn store(flash: CutFlash) -> ParamStore<CutFlash> {
-    ParamStore::new(flash, 0, PAGE as u32).expect("layout")
+    store_in_slots(flash, 1)
+}
+
+/// The store on slots of `pages` erase pages each, A first, B right after it.
+fn store_in_slots(flash: CutFlash, pages: usize) -> ParamStore<CutFlash> {
+    let len = (pages * PAGE) as u32;
+    ParamStore::new(flash, 0, len, len).expect("layout")
 }
 
 /// A table that differs from the defaults in every entry by `k` (valid for small k).
@@ -166,19 +172,24 @@ fn table(k: f32) -> [f32; COUNT] {
 /// new one from then on; a save after the cut always succeeds. Returns the number of cut
 /// points tried.
 fn cut_everywhere(before: &[[f32; COUNT]]) -> usize {
-    let mut base = store(CutFlash::blank(2));
+    cut_everywhere_in(1, before)
+}
+
+/// [`cut_everywhere`] on slots of `pages` erase pages each.
+fn cut_everywhere_in(pages: usize, before: &[[f32; COUNT]]) -> usize {
+    let mut base = store_in_slots(CutFlash::blank(2 * pages), pages);
     for t in before {
         base.save(t).unwrap();
     }
     let base_mem = base.into_inner().mem;
     let old = before.last().copied();
     let new = table(9.0);
-    let total = PAGE + RECORD_LEN + COMMIT_LEN;
+    let total = pages * PAGE + RECORD_LEN + COMMIT_LEN;
     for cut in 0..=total {
-        let mut s = store(CutFlash::reboot(base_mem.clone(), Some(cut)));
+        let mut s = store_in_slots(CutFlash::reboot(base_mem.clone(), Some(cut)), pages);
         let result = s.save(&new);
         let mem = s.into_inner().mem;
-        let mut rebooted = store(CutFlash::reboot(mem.clone(), None));
+        let mut rebooted = store_in_slots(CutFlash::reboot(mem.clone(), None), pages);
         let (values, outcome) = rebooted.load();
         if cut < total {
             assert_eq!(
@@ -200,9 +211,10 @@ fn cut_everywhere(before: &[[f32; COUNT]]) -> usize {
         assert_eq!(rebooted.load().0, Some(again), "save after cut {cut}");
     }
     println!(
-        "{} saves before: {} cut points (erase {PAGE} B, record {RECORD_LEN} B, commit {COMMIT_LEN} B), each reloads the previous table",
+        "{} saves before: {} cut points (erase {} B, record {RECORD_LEN} B, commit {COMMIT_LEN} B), each reloads the previous table",
         before.len(),
-        total + 1
+        total + 1,
+        pages * PAGE
     );
     total + 1
 }
@@ -223,6 +235,15 @@ fn a_power_cut_anywhere_in_a_save_leaves_the_previous_table() {
 fn a_power_cut_while_overwriting_the_older_page_leaves_the_newer_table() {
     // A holds table 1, B table 2: the save erases A; table 2 must survive.
     cut_everywhere(&[table(1.0), table(2.0)]);
+}
+
+#[test]
+fn a_slot_of_several_pages_is_erased_whole_and_survives_a_cut_in_any_page() {
+    // A record that outgrows one page (a compensation table) takes more pages per slot:
+    // the save erases the whole slot, and a cut in its second page still leaves the
+    // previous table in the other slot.
+    let n = cut_everywhere_in(2, &[table(1.0), table(2.0)]);
+    assert_eq!(n, 2 * PAGE + RECORD_LEN + COMMIT_LEN + 1);
 }
 
 #[test]
@@ -373,17 +394,25 @@ fn a_corrupt_newer_page_falls_back_to_the_older_valid_one_without_a_fault() {
 }
 
 #[test]
-fn misplaced_pages_are_refused() {
-    assert!(matches!(
-        ParamStore::new(CutFlash::blank(2), 8, PAGE as u32),
-        Err(StoreError::Layout)
-    ));
-    assert!(matches!(
-        ParamStore::new(CutFlash::blank(2), 0, 0),
-        Err(StoreError::Layout)
-    ));
-    assert!(matches!(
-        ParamStore::new(CutFlash::blank(2), 0, 2 * PAGE as u32),
-        Err(StoreError::Layout)
-    ));
+fn misplaced_slots_are_refused() {
+    let page = PAGE as u32;
+    for (a, b, len, why) in [
+        (8, page, page, "not page-aligned"),
+        (0, 0, page, "the same slot"),
+        (0, 2 * page, page, "B past the end of a 2-page flash"),
+        (0, page, 2 * page, "overlapping two-page slots"),
+        (0, page, page + 8, "not a whole number of pages"),
+        (0, page, 0, "empty"),
+        (page, 0, u32::MAX, "past the address range"),
+    ] {
+        assert!(
+            matches!(
+                ParamStore::new(CutFlash::blank(2), a, b, len),
+                Err(StoreError::Layout)
+            ),
+            "{why}"
+        );
+    }
+    // B before A is fine.
+    assert!(ParamStore::new(CutFlash::blank(2), page, 0, page).is_ok());
 }
