@@ -4,8 +4,8 @@
 //! 2. `cargo fmt --check` and `cargo clippy --workspace --all-targets -D warnings`;
 //! 3. the host tests of the whole workspace;
 //! 4. the firmware for the STM32G474RE with warnings denied, and its flash and static-RAM
-//!    use against the budget (64 KiB / 16 KiB, so it also fits an STM32G431), written to
-//!    `target/firmware-size.json`.
+//!    use against the budget (96 KiB / 16 KiB, so it also fits an STM32G431xB with the
+//!    parameter pages), written to `target/firmware-size.json`.
 //!
 //! 5. the processor-in-the-loop run in QEMU ([`pil`]): the control core and the plant on
 //!    the Cortex-M4F, telemetry through defmt and `eha ingest`, compared with the host run,
@@ -21,7 +21,8 @@ use std::process::Command;
 mod pil;
 
 const TARGET: &str = "thumbv7em-none-eabihf";
-const FLASH_BUDGET: u64 = 64 * 1024;
+/// 96 KiB: an STM32G431xB (128 KiB) still holds the image and the parameter store's pages.
+const FLASH_BUDGET: u64 = 96 * 1024;
 const RAM_BUDGET: u64 = 16 * 1024;
 
 fn main() {
