@@ -7,10 +7,11 @@
 //! fraction (computed by the core's fixed-point [`duty_to_compare`], saturating, NaN → 0). Compare values are preloaded and take effect at the next update event (the
 //! counter peak), so a period is never cut between two duties.
 //!
-//! A break (the gate driver's fault line) clears MOE in hardware. The bridge then stays
-//! off, whatever the controller asks, until the controller itself has turned the PWM off
-//! (the control interrupt drives it to Disabled when it sees the break), so a fault is
-//! never cleared by the hardware alone.
+//! A break (the gate driver's fault line, a phase-current comparator, or a break the
+//! firmware forced) clears MOE in hardware. The bridge then stays off, whatever the
+//! controller asks, until the controller itself has turned the PWM off (the control
+//! interrupt latches fault 17 when it sees the break, which drops the mode to Disabled),
+//! so a fault is never cleared by the hardware alone.
 
 use super::board::{PowerStage, PWM_REGS};
 use firmware::scaling::duty_to_compare;

@@ -10,8 +10,16 @@
 //! sends queued replies and, when none is due, a status every [`STATUS_PERIOD`]. The
 //! command timeout itself is the controller's: heartbeats are forwarded to it like any
 //! other command.
+//!
+//! The FDCAN's acceptance filter passes only this node's command frames
+//! ([`firmware::can_protocol::acceptance_filters`], set in [`super::board`]), and its
+//! interrupt moves them from the three-deep hardware FIFO into a queue of [`RX_QUEUE`]
+//! frames, so a burst that arrives while a parameter save blocks the tasks for ~22 ms is
+//! kept, not overwritten.
 
-use embassy_stm32::can::{Can, CanRx, CanTx, Frame as HalFrame};
+use embassy_stm32::can::{
+    BufferedCan, BufferedCanSender, CanConfigurator, Frame as HalFrame, RxBuf, TxBuf,
+};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_time::{with_timeout, Duration};
@@ -28,6 +36,13 @@ use super::param_flash::{self, Store};
 
 /// Period of the unsolicited status frame.
 pub const STATUS_PERIOD: Duration = Duration::from_millis(100);
+/// Received frames held between the CAN interrupt and the receive task.
+pub const RX_QUEUE: usize = 16;
+/// Frames held between the transmit task and the CAN interrupt.
+pub const TX_QUEUE: usize = 4;
+
+/// The started CAN peripheral with its queues, as the receive task reads it.
+pub type Link = BufferedCan<'static, TX_QUEUE, RX_QUEUE>;
 
 /// What the receive task asks the transmit task to send.
 #[derive(Clone, Copy)]
@@ -40,17 +55,25 @@ enum Outgoing {
 
 static OUTGOING: Channel<CriticalSectionRawMutex, Outgoing, 4> = Channel::new();
 
-/// Splits the started CAN peripheral into the two halves the tasks take.
-pub fn split(can: Can<'static>) -> (CanTx<'static>, CanRx<'static>) {
-    let (tx, rx, _properties) = can.split();
-    (tx, rx)
+/// Starts the CAN peripheral with its queues; returns the link for the receive task and
+/// the sender for the transmit task. Called once (its queues are static).
+pub fn start(can: CanConfigurator<'static>) -> (Link, BufferedCanSender) {
+    let tx = cortex_m::singleton!(: TxBuf<TX_QUEUE> = TxBuf::new());
+    let rx = cortex_m::singleton!(: RxBuf<RX_QUEUE> = RxBuf::new());
+    let (Some(tx), Some(rx)) = (tx, rx) else {
+        defmt::panic!("CAN started twice");
+    };
+    let link = can.into_normal_mode().buffered(tx, rx);
+    let sender = link.writer();
+    (link, sender)
 }
 
-/// Receives and executes commands.
+/// Receives and executes commands. `store` is `None` when the flash has no parameter
+/// store (fault 18); a save is then refused.
 #[embassy_executor::task]
-pub async fn receive(mut rx: CanRx<'static>, node: NodeId, mut store: Store) {
+pub async fn receive(mut link: Link, node: NodeId, mut store: Option<Store>) {
     loop {
-        let envelope = match rx.read().await {
+        let envelope = match link.read().await {
             Ok(e) => e,
             Err(e) => {
                 defmt::warn!("CAN bus error: {}", e);
@@ -75,7 +98,7 @@ pub async fn receive(mut rx: CanRx<'static>, node: NodeId, mut store: Store) {
 
 /// Sends replies and the periodic status.
 #[embassy_executor::task]
-pub async fn transmit(mut tx: CanTx<'static>, node: NodeId) {
+pub async fn transmit(mut tx: BufferedCanSender, node: NodeId) {
     let mut sequence: u8 = 0;
     let mut last_command = NO_COMMAND;
     loop {
@@ -92,29 +115,34 @@ pub async fn transmit(mut tx: CanTx<'static>, node: NodeId) {
         }
         let frame = encode_reply(&reply, node);
         if let Ok(hal) = HalFrame::new_standard(frame.id(), frame.payload()) {
-            // `write` waits for a free mailbox; a frame displaced by a higher-priority one
-            // is dropped, the next status supersedes it.
-            let _ = tx.write(&hal).await;
+            // Waits for room in the queue the CAN interrupt drains.
+            tx.write(hal).await;
         }
     }
 }
 
-fn execute(request: &Request, store: &mut Store) -> Option<Outgoing> {
+fn execute(request: &Request, store: &mut Option<Store>) -> Option<Outgoing> {
     match control::with_controller(|c| serve(request, c))? {
         Response::Silent => None,
         Response::Ack(function) => Some(Outgoing::Ack(function)),
         Response::Reply(reply) => Some(Outgoing::Reply(reply)),
-        // `serve` checked that the bridge is off; the flash write stalls the CPU ~25 ms.
-        Response::Save(values) => match param_flash::save(store, &values) {
-            Ok(sequence) => {
-                defmt::info!("parameters: table {} saved", sequence);
-                Some(Outgoing::Ack(Function::SaveParameters.code()))
+        // `serve` checked that the bridge is off; the erase blocks the tasks ~22 ms.
+        Response::Save(values) => {
+            let Some(store) = store.as_mut() else {
+                defmt::error!("parameters: no parameter store (fault 18), not saved");
+                return Some(Outgoing::Reply(save_failed()));
+            };
+            match param_flash::save(store, &values) {
+                Ok(sequence) => {
+                    defmt::info!("parameters: table {} saved", sequence);
+                    Some(Outgoing::Ack(Function::SaveParameters.code()))
+                }
+                Err(_) => {
+                    defmt::error!("parameters: flash write failed");
+                    Some(Outgoing::Reply(save_failed()))
+                }
             }
-            Err(_) => {
-                defmt::error!("parameters: flash write failed");
-                Some(Outgoing::Reply(save_failed()))
-            }
-        },
+        }
     }
 }
 

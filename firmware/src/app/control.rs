@@ -10,18 +10,31 @@
 //! Overrun: if ADC1 has already finished the next period's sequence when the body ends,
 //! the loop missed a sample; the controller latches its watchdog fault and the bridge is
 //! turned off at once. Liveness for the independent watchdog is the interrupt counter
-//! [`isr_count`], read by the supervision task.
+//! [`isr_count`], read by the supervision task. A hardware break (gate-driver fault line,
+//! phase comparator, or a break forced by [`super::safe_state`]) latches fault 17; which
+//! sources were active is kept for the supervision task's log ([`last_break_sources`]).
+//!
+//! Telemetry is captured here, every `telemetry_decimation` periods exactly: the frame
+//! goes into a queue of [`TELEMETRY_QUEUE`] frames without waiting (dropped and counted
+//! when it is full, [`telemetry_dropped`]) and the telemetry task logs it; nothing on the
+//! way can block this interrupt.
 
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m::peripheral::DWT;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::blocking_mutex::CriticalSectionMutex;
-use firmware::{Command, Controller, Mode};
+use embassy_sync::channel::Channel;
+use firmware::{Controller, TelemetryFrame};
 
-use super::board::CURRENT_ADC_REGS;
+use super::board::{self, CURRENT_ADC_REGS};
 use super::bridge::{Bridge, BridgeEvent};
 use super::sensors::Sensors;
+
+/// Frames the telemetry queue holds: 1.6 ms at full rate (20 kHz), more than the
+/// telemetry task's longest wait behind the other tasks.
+pub const TELEMETRY_QUEUE: usize = 32;
 
 /// What the control interrupt owns.
 pub struct Drive {
@@ -29,6 +42,8 @@ pub struct Drive {
     pub controller: Controller,
     bridge: Bridge,
     sensors: Sensors,
+    /// Periods until the next telemetry frame.
+    telemetry_countdown: u32,
 }
 
 static DRIVE: CriticalSectionMutex<RefCell<Option<Drive>>> =
@@ -37,6 +52,10 @@ static ISR_COUNT: AtomicU32 = AtomicU32::new(0);
 static ISR_MAX_CYCLES: AtomicU32 = AtomicU32::new(0);
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
 static BREAKS: AtomicU32 = AtomicU32::new(0);
+static BREAK_SOURCES: AtomicU32 = AtomicU32::new(0);
+static TELEMETRY_DROPPED: AtomicU32 = AtomicU32::new(0);
+static TELEMETRY: Channel<CriticalSectionRawMutex, TelemetryFrame, TELEMETRY_QUEUE> =
+    Channel::new();
 
 /// Installs the drive; the interrupt does nothing before this.
 pub fn install(controller: Controller, bridge: Bridge, sensors: Sensors) {
@@ -45,6 +64,7 @@ pub fn install(controller: Controller, bridge: Bridge, sensors: Sensors) {
             controller,
             bridge,
             sensors,
+            telemetry_countdown: 1,
         }))
     });
 }
@@ -79,6 +99,21 @@ pub fn breaks() -> u32 {
     BREAKS.load(Ordering::Relaxed)
 }
 
+/// The break sources active when the last break was seen ([`board::break_sources`]).
+pub fn last_break_sources() -> u8 {
+    BREAK_SOURCES.load(Ordering::Relaxed) as u8
+}
+
+/// Telemetry frames dropped because the queue was full (wraps).
+pub fn telemetry_dropped() -> u32 {
+    TELEMETRY_DROPPED.load(Ordering::Relaxed)
+}
+
+/// The next telemetry frame, when the interrupt has queued one.
+pub async fn next_telemetry_frame() -> TelemetryFrame {
+    TELEMETRY.receive().await
+}
+
 /// The interrupt body (called from the vector in the board module).
 pub fn on_current_sample_interrupt() {
     let start = DWT::cycle_count();
@@ -99,10 +134,18 @@ impl Drive {
         let m = self.sensors.sample();
         let out = self.controller.on_current_sample(&m);
         if self.bridge.apply(&out) == BridgeEvent::Break {
-            // The hardware has already cut the bridge; bring the controller to the same
-            // state so that restarting takes a command.
+            // The hardware has already cut the bridge; the controller latches it, so
+            // restarting takes the operator's clear.
+            BREAK_SOURCES.store(u32::from(board::break_sources()), Ordering::Relaxed);
             BREAKS.fetch_add(1, Ordering::Relaxed);
-            let _ = self.controller.command(Command::SetMode(Mode::Disabled));
+            self.controller.report_hardware_break();
+        }
+        self.telemetry_countdown = self.telemetry_countdown.saturating_sub(1);
+        if self.telemetry_countdown == 0 {
+            self.telemetry_countdown = self.controller.telemetry_decimation();
+            if TELEMETRY.try_send(self.controller.telemetry()).is_err() {
+                TELEMETRY_DROPPED.fetch_add(1, Ordering::Relaxed);
+            }
         }
         if CURRENT_ADC_REGS.isr().read().jeos() {
             OVERRUNS.fetch_add(1, Ordering::Relaxed);

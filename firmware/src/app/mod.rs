@@ -2,25 +2,32 @@
 //! peripherals of the NUCLEO-G474RE.
 //!
 //! - [`board`]: every pin, peripheral instance and clock (the one module to change for
-//!   another board), and the interrupt vector of the current loop.
+//!   another board), the hardware over-current trip, and the interrupt vector of the
+//!   current loop.
 //! - [`control`]: the current-loop interrupt (highest priority, not a task) and the state
 //!   it shares with the tasks; [`bridge`] and [`sensors`] are its drivers.
-//! - [`param_flash`]: the parameter table in the last two flash pages.
+//! - [`safe_state`]: the bridge off on a panic, a HardFault, a debug halt or a stall.
+//! - [`param_flash`]: the parameter table at the end of flash bank 2.
 //! - Tasks on the thread-mode executor: [`can_link`] (commands and replies over FDCAN1),
 //!   [`telemetry`] (defmt over RTT), [`supervision`] (independent watchdog, LED, load).
 //!
 //! Start-up: configuration validated (on error the bridge stays off and the error is
 //! logged), peripherals brought up with the bridge disabled, the stored parameter table
-//! applied over the defaults ([`firmware::param_store::boot`]: a corrupt,
-//! other-version or inconsistent record gives the defaults and latches fault 16), the
-//! drive installed, the interrupt enabled, the tasks spawned. The drive starts in Disabled; a CAN `SetMode`
-//! command starts it.
+//! applied over the defaults ([`firmware::param_store::boot`]: a corrupt, other-version
+//! or inconsistent record gives the defaults and latches fault 16; a flash without the
+//! dual-bank layout gives the defaults and fault 18), a watchdog reset of the previous run
+//! latched as fault 11, the drive installed, the interrupt enabled, the tasks spawned. The
+//! drive starts in Disabled and measures its current offsets; a CAN `SetMode` command
+//! starts it once the offsets are measured and (for Speed and Pressure) the encoder index
+//! has been seen or Calibrating has aligned the rotor. `docs/bring-up.md` is the bench
+//! procedure.
 
 mod board;
 mod bridge;
 mod can_link;
 mod control;
 mod param_flash;
+mod safe_state;
 mod sensors;
 mod supervision;
 mod telemetry;
@@ -31,9 +38,9 @@ use embassy_time::Timer;
 use firmware::can_protocol::NodeId;
 use firmware::param_store::{boot, BootOutcome};
 use firmware::{Config, Controller};
-use panic_probe as _;
 
 use bridge::Bridge;
+use param_flash::Store;
 use sensors::Sensors;
 
 #[embassy_executor::main]
@@ -62,26 +69,27 @@ async fn main(spawner: Spawner) {
     };
 
     enable_cycle_counter();
-    let b = board::init(pwm_hz, config.sensors.encoder_counts_per_rev);
-    // The live table covers gains, limits and commissioning results, never the rates or
-    // the encoder resolution the board was just set up with.
-    let mut store = match param_flash::open(b.flash) {
-        Ok(s) => s,
-        Err(_) => defmt::panic!("parameter pages do not fit the flash layout"),
-    };
+    let b = board::init(pwm_hz, &config, node);
+    let t = b.timing;
+    defmt::info!(
+        "power stage: TIM1 at {=u32} Hz, dead time {=u32} ns, break filter {=u32} ns, over-current trip at {=f32} A (DAC3 code {=u16})",
+        t.timer_hz,
+        t.dead_time_ns,
+        t.break_filter_ns,
+        config.limits.hardware_over_current_a,
+        t.trip_code
+    );
     // Built from the constant nominal configuration, then given the stored table: the
     // constructor folds at compile time, the table goes through the live-parameter path.
+    // The live table covers gains, limits and commissioning results, never the rates or
+    // the encoder resolution the board was just set up with.
     let mut controller = Controller::new(&config);
-    let outcome = boot(&mut store, |v| controller.load_parameters(v).is_ok());
-    match outcome {
-        BootOutcome::Stored { sequence } => {
-            defmt::info!("parameters: stored table {} loaded", sequence)
-        }
-        BootOutcome::Defaults => defmt::info!("parameters: none stored, defaults"),
-        BootOutcome::DefaultsAfterInvalid(_) => {
-            defmt::error!("parameters: stored table unusable, defaults loaded (fault 16)");
-            controller.report_parameter_store_invalid();
-        }
+    let store = load_parameters(b.flash, &mut controller);
+    if b.watchdog_reset {
+        defmt::error!(
+            "the previous run ended in a watchdog reset (stalled loop, panic or HardFault): fault 11"
+        );
+        controller.report_watchdog_reset();
     }
     let decimation = controller.telemetry_decimation();
     control::install(controller, Bridge::new(b.power), Sensors::new(b.sensors));
@@ -94,11 +102,38 @@ async fn main(spawner: Spawner) {
         decimation
     );
 
-    let (tx, rx) = can_link::split(b.can.into_normal_mode());
-    spawner.spawn(unwrap_spawn(can_link::receive(rx, node, store)));
-    spawner.spawn(unwrap_spawn(can_link::transmit(tx, node)));
-    spawner.spawn(unwrap_spawn(telemetry::run(pwm_hz)));
+    let (link, sender) = can_link::start(b.can);
+    spawner.spawn(unwrap_spawn(can_link::receive(link, node, store)));
+    spawner.spawn(unwrap_spawn(can_link::transmit(sender, node)));
+    spawner.spawn(unwrap_spawn(telemetry::run()));
     spawner.spawn(unwrap_spawn(supervision::run(b.watchdog, b.led, pwm_hz)));
+}
+
+/// Opens the parameter store and applies its table to `controller`; latches fault 16 for
+/// an unusable table and fault 18 when the flash has no store. Returns the store for the
+/// save command.
+fn load_parameters(
+    flash: Option<embassy_stm32::flash::Flash<'static, embassy_stm32::flash::Blocking>>,
+    controller: &mut Controller,
+) -> Option<Store> {
+    let Some(mut store) = flash.and_then(|f| param_flash::open(f).ok()) else {
+        defmt::error!(
+            "parameters: flash option bit DBANK is cleared (single bank): no parameter store, defaults loaded (fault 18); set DBANK, see docs/bring-up.md"
+        );
+        controller.report_parameter_flash_layout();
+        return None;
+    };
+    match boot(&mut store, |v| controller.load_parameters(v).is_ok()) {
+        BootOutcome::Stored { sequence } => {
+            defmt::info!("parameters: stored table {} loaded", sequence)
+        }
+        BootOutcome::Defaults => defmt::info!("parameters: none stored, defaults"),
+        BootOutcome::DefaultsAfterInvalid(_) => {
+            defmt::error!("parameters: stored table unusable, defaults loaded (fault 16)");
+            controller.report_parameter_store_invalid();
+        }
+    }
+    Some(store)
 }
 
 /// Each task is spawned once, so its pool of one is always free: a failure here is a

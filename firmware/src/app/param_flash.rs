@@ -1,37 +1,64 @@
-//! The parameter table in the G474's flash: the last two erase pages of the bank (4 KiB
-//! each in single-bank mode, outside the program: `memory.x` gives the linker 8 KiB less
-//! than the part has), opened at boot and written by the `SaveParameters` command through
-//! [`firmware::param_store`].
+//! The parameter table in the G474's flash: two slots at the end of bank 2, opened at boot
+//! and written by the `SaveParameters` command through [`firmware::param_store`].
 //!
-//! A page erase stalls every instruction fetch from the (single) bank for about 22 ms
-//! (datasheet: 24.5 ms at most), the current-loop interrupt and the executor included.
-//! Saving is therefore allowed in Disabled only (checked by
-//! [`firmware::can_server::serve`]), and around the flash operations this module
+//! # Geometry
 //!
-//! - masks the current-loop interrupt, so the loop resumes cleanly afterwards instead of
-//!   running once, late, on a stale sample (its overrun check would latch the watchdog
-//!   fault);
+//! The part runs dual-bank (option bit DBANK set, as it ships): two 256 KiB banks of
+//! 2 KiB pages. The program is linked into bank 1 only (`memory.x`); the store's slots
+//! are the last [`SLOT_BYTES`] × 2 of bank 2. [`SLOT_BYTES`] is the one number to change
+//! when the stored record grows (a compensation table of a few KiB): a whole number of
+//! pages per slot, the slots move down from the end of bank 2, nothing else in the image
+//! or the linker script changes (the compile-time checks below hold the layout to that).
+//! A part with DBANK cleared (single bank, 4 KiB pages) would have the driver erase the
+//! wrong pages: [`super::board::init`] leaves the flash unopened there and the drive runs
+//! on its defaults with fault 18 (`docs/bring-up.md` says how to set the bit).
+//!
+//! # Saving while the loop runs
+//!
+//! Erasing or programming bank 2 does not stall instruction fetches from bank 1 (the G4
+//! reads one bank while it writes the other), so the current-loop interrupt keeps running
+//! through a save. The CAN task that saves is blocked for the erase (about 22 ms,
+//! datasheet at most 24.5 ms) and so is the rest of the thread-mode executor — the
+//! supervision task included. Around the flash operations this module therefore
+//!
 //! - stretches the independent watchdog's reload to its longest (about 0.5 s) and restores
 //!   it after: the 20 ms timeout is shorter than one erase;
 //! - counts a maintenance window ([`maintenance_windows`]), so the supervision task does
-//!   not take the missing interrupts for a stalled loop.
+//!   not take its own late checks for a stalled loop.
+//!
+//! Saving is still allowed in Disabled only ([`firmware::can_server::serve`]): the
+//! command timeout and the CAN replies wait for the erase.
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use embassy_stm32::flash::{Blocking, Flash, FLASH_SIZE, MAX_ERASE_SIZE};
-use embassy_stm32::interrupt::{self, InterruptExt};
 use embassy_stm32::pac;
 use embassy_stm32::pac::iwdg::vals::Key;
-use firmware::param_store::{ParamStore, StoreError};
+use firmware::param_store::{ParamStore, StoreError, SPAN};
 use firmware::parameters::COUNT;
 
 /// The store on the G474 flash.
 pub type Store = ParamStore<Flash<'static, Blocking>>;
 
-/// Offset of page A (second-to-last erase page) from the flash start. [bytes]
-pub const PAGE_A: u32 = (FLASH_SIZE - 2 * MAX_ERASE_SIZE) as u32;
-/// Offset of page B (last erase page) from the flash start. [bytes]
-pub const PAGE_B: u32 = (FLASH_SIZE - MAX_ERASE_SIZE) as u32;
+/// Erase page of bank 2 in dual-bank mode. [bytes]
+pub const PAGE_BYTES: u32 = MAX_ERASE_SIZE as u32;
+/// One slot (A or B) of the stored record: a whole number of [`PAGE_BYTES`]. One page
+/// holds today's record ([`SPAN`] bytes: the live table with header, CRC and commit
+/// word); grow it in whole pages when the record grows. [bytes]
+pub const SLOT_BYTES: u32 = PAGE_BYTES;
+/// Offset of bank 2 from the flash start. [bytes]
+pub const BANK2: u32 = (FLASH_SIZE / 2) as u32;
+/// Offset of slot B (the last slot of bank 2) from the flash start. [bytes]
+pub const SLOT_B: u32 = FLASH_SIZE as u32 - SLOT_BYTES;
+/// Offset of slot A (right below slot B) from the flash start. [bytes]
+pub const SLOT_A: u32 = SLOT_B - SLOT_BYTES;
+
+const _: () = assert!(SLOT_BYTES % PAGE_BYTES == 0, "a slot is whole pages");
+const _: () = assert!(SPAN as u32 <= SLOT_BYTES, "the record fits its slot");
+const _: () = assert!(
+    SLOT_A >= BANK2,
+    "the store stays in bank 2, clear of the program"
+);
 
 /// Longest IWDG reload value (12-bit counter).
 const IWDG_RELOAD_MAX: u16 = 0x0FFF;
@@ -44,28 +71,23 @@ pub fn maintenance_windows() -> u32 {
     MAINTENANCE.load(Ordering::Relaxed)
 }
 
-/// Opens the store on the last two pages.
+/// Opens the store on its two slots.
 pub fn open(
     flash: Flash<'static, Blocking>,
 ) -> Result<Store, StoreError<embassy_stm32::flash::Error>> {
-    ParamStore::new(flash, PAGE_A, PAGE_B, MAX_ERASE_SIZE as u32)
+    ParamStore::new(flash, SLOT_A, SLOT_B, SLOT_BYTES)
 }
 
-/// Saves `values` with the current loop masked and the watchdog stretched; returns the
-/// record's sequence number. Call only with the bridge disabled.
+/// Saves `values` with the watchdog stretched; returns the record's sequence number. Call
+/// only with the bridge disabled.
 pub fn save(
     store: &mut Store,
     values: &[f32; COUNT],
 ) -> Result<u32, StoreError<embassy_stm32::flash::Error>> {
     MAINTENANCE.fetch_add(1, Ordering::Relaxed);
-    interrupt::ADC1_2.disable();
     let reload = set_watchdog_reload(IWDG_RELOAD_MAX);
     let result = store.save(values);
     set_watchdog_reload(reload);
-    interrupt::ADC1_2.unpend();
-    // SAFETY: re-enables the handler that was enabled before this call; it only touches
-    // state behind a critical-section mutex.
-    unsafe { interrupt::ADC1_2.enable() };
     MAINTENANCE.fetch_add(1, Ordering::Relaxed);
     result
 }

@@ -4,11 +4,12 @@
 //! [`Measurements`].
 //!
 //! Both ADCs convert at the same TIM1 trigger (the counter peak). The control interrupt
-//! fires at the end of ADC1's short sequence (about 2 µs); ADC2's 16-fold oversampled
-//! pressure conversion takes about 14 µs, so its data register still holds the result of
-//! the previous period — a 50 µs delay, negligible for the 1 kHz pressure loop. (At PWM
-//! rates above about 60 kHz the pressure conversion outlasts the period and only every
-//! other trigger is converted; the value is then two periods old.)
+//! fires at the end of ADC1's sequence (about 4 µs: three phase currents, then the DC
+//! link's long sample time); ADC2's 16-fold oversampled pressure conversion takes about
+//! 23 µs, so its data register still holds the result of the previous period — a 50 µs
+//! delay, negligible for the 1 kHz pressure loop. (At PWM rates above about 44 kHz the
+//! pressure conversion outlasts the period and only every other trigger is converted; the
+//! value is then two periods old.)
 
 use super::board::{SensorPeripherals, ENCODER_INDEX_CHANNEL, ENCODER_REGS};
 use firmware::Measurements;
