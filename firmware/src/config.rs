@@ -374,6 +374,33 @@ impl Config {
         }
     }
 
+    /// The first power-up on a current-limited bench supply of 24‥48 V
+    /// (`docs/bring-up.md`; the firmware's `bring-up` feature): the nominal motor and
+    /// loops, with the DC-link window, the PI voltage limit and every current and speed
+    /// limit lowered, so a wiring, sign or offset error trips at a few amperes and a few
+    /// tens of rad/s instead of the nominal 45 A and 260 rad/s.
+    pub fn bring_up() -> Config {
+        let mut c = Config::nominal();
+        c.motor.dc_link_nominal_v = 48.0;
+        // 48 V / √3, the SVPWM linear limit at 48 V.
+        c.current.voltage_limit_v = 27.0;
+        c.speed.iq_limit_a = 3.0;
+        c.speed.speed_limit_rad_s = 30.0;
+        c.limits.over_current_a = 6.0;
+        c.limits.hardware_over_current_a = 8.0;
+        c.limits.under_voltage_v = 18.0;
+        c.limits.over_voltage_v = 60.0;
+        c.limits.over_speed_rad_s = 40.0;
+        c.calibration.alignment_current_a = 2.0;
+        let k = &mut c.commissioning;
+        k.current_a = 4.0;
+        k.spin_current_a = 2.0;
+        k.pulse_voltage_v = 12.0;
+        // Back-EMF at 20 rad/s: 4 · 20 · 0.1827 = 14.6 V, inside the 27 V limit.
+        k.spin_speed_rad_s = 20.0;
+        c
+    }
+
     /// The same configuration at another PWM (current-loop) rate, keeping the speed- and
     /// pressure-loop rates (for example 100 kHz, Table 1's 1e-5 s).
     pub fn with_pwm_hz(mut self, pwm_hz: f32) -> Config {
@@ -728,6 +755,22 @@ mod tests {
             let e = c.validate().expect_err(field);
             assert_eq!(e.field, field, "{e}");
         }
+    }
+
+    #[test]
+    fn the_bring_up_configuration_is_valid_and_trips_at_a_few_amperes() {
+        let c = Config::bring_up();
+        assert_eq!(c.validate(), Ok(()));
+        // A 48 V supply sits inside the DC-link window; the nominal 280 V does not.
+        assert!(c.limits.under_voltage_v < 24.0 && 48.0 < c.limits.over_voltage_v);
+        assert!(c.limits.over_voltage_v < 280.0);
+        assert!(c.limits.hardware_over_current_a <= 10.0);
+        // Alignment and commissioning stay below the software trip.
+        assert!(c.calibration.alignment_current_a < c.limits.over_current_a);
+        assert!(c.commissioning.current_a < c.limits.over_current_a);
+        // The loops are the nominal ones.
+        let n = Config::nominal();
+        assert_eq!((c.current.kp_q, c.speed.kp), (n.current.kp_q, n.speed.kp));
     }
 
     #[test]

@@ -45,7 +45,10 @@ use sensors::Sensors;
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
+    #[cfg(not(feature = "bring-up"))]
     let config = Config::nominal();
+    #[cfg(feature = "bring-up")]
+    let config = Config::bring_up();
     if let Err(e) = config.validate() {
         defmt::error!(
             "configuration refused: {} {}; the bridge stays off",
