@@ -269,7 +269,7 @@ mod tests {
             let s2 = cl.apply_voltage(&m0, th, u);
             let in_force: [f32; 3] = core::array::from_fn(|p| s1.duties[p].max(s2.duties[p]));
             let truth = [0.0, -tau3, tau3].map(|shift| {
-                let phase = th - 0.5236 + shift;
+                let phase = th - core::f32::consts::FRAC_PI_6 + shift;
                 -20.0 * libm::sinf(phase)
             });
             let mut adc = [0u16; 3];
