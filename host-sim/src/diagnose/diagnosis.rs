@@ -36,6 +36,9 @@ pub struct Fit {
     pub rmse_pa: f64,
     /// The same fit measure for each logged signal the model predicts. [%]
     pub fit_percent_by_signal: BTreeMap<String, f64>,
+    /// Per signal, the residual's RMS over the log's own noise RMS (1.0: explained down to
+    /// the sensor noise). [1]
+    pub noise_ratio_by_signal: BTreeMap<String, f64>,
 }
 
 /// One candidate cause.
@@ -62,6 +65,8 @@ pub struct Extended {
     pub rmse_pa: f64,
     /// Fit per signal. [%]
     pub fit_percent_by_signal: BTreeMap<String, f64>,
+    /// Residual RMS over noise RMS per signal. [1]
+    pub noise_ratio_by_signal: BTreeMap<String, f64>,
 }
 
 /// What the extension gained on the validation segment.

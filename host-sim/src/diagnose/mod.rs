@@ -1,48 +1,56 @@
-//! `eha diagnose` (issue 5): what the simulation gets wrong on a bench log, why, the
-//! extended model, and the gain on data the fit never saw.
+//! `eha diagnose`: what the model gets wrong on a measured log, why, the extended model,
+//! and the gain on data the fit never saw. A pipeline that reads top to bottom
+//! ([`analysis`] lists the stages):
 //!
-//! - [`replay`]: the subsystem replays — hydraulics driven by the logged shaft angle (or
-//!   speed) and piston position, motor and shaft driven by the logged d-q currents — with
-//!   the simulated signals aligned with the log's rows.
-//! - [`fit_percent`] and [`residual`]: the contract's goodness of fit (normalised root mean
-//!   square error, MATLAB `compare`) and the residual the diagnosis analyses.
-//!
-//! - [`predict`], [`electrical`], [`closed_replay`]: the predictors the diagnosis compares
-//!   with the log (hydraulics, motor, stator voltages; the whole closed loop).
-//! - [`spectrum`]: residual order spectra against the shaft angle.
-//! - [`candidates`], [`fit`]: the catalogue's effects as candidates, fitted with `argmin`.
-//! - [`analysis`]: the diagnosis itself; [`diagnosis`]: its result (the contract's JSON);
-//!   [`report`]: the markdown report; [`command`]: `eha diagnose`.
+//! - [`facts`]: facts about the log, computed once (sampling, angle, noise, segments,
+//!   steady windows).
+//! - The parity relations, each predicting one logged signal from the others over short
+//!   windows re-started from the measurement, so nothing drifts: [`hydraulic`] (pressure
+//!   from the shaft angle), [`mechanical`] (q current and speed from the torque balance),
+//!   [`electrical`] (voltages, when logged), [`cylinder`] (pressure from the piston's
+//!   force balance, when it moves).
+//! - [`least_squares`] and [`calibration`]: the nominal model fitted to the log within the
+//!   rig's tolerance bands (Gaussian priors), and with one effect's parameter released.
+//! - [`lines`], [`angle_locked`], [`dead_time`]: the angle-locked lines of the steady
+//!   windows and the effects that make them.
+//! - [`candidates`], [`decision`]: every effect tested, and the one the log convicts.
+//! - [`predictions`]: the contract's per-signal predictions and scores.
+//! - [`signatures`], [`spectrum`]: the baseline residuals' time-domain signatures and
+//!   order spectra, for the report.
+//! - [`diagnosis`]: the contract's JSON; [`report`]: the markdown report; [`command`]: the
+//!   CLI.
 
 pub mod analysis;
+pub mod angle_locked;
+pub mod calibration;
 pub mod candidates;
-pub mod closed_replay;
 pub mod command;
+pub mod cylinder;
+pub mod dead_time;
+pub mod decision;
 pub mod diagnosis;
 pub mod electrical;
-pub mod fit;
-pub mod lock_in;
-pub mod predict;
-pub mod replay;
+pub mod facts;
+pub mod hydraulic;
+pub mod least_squares;
+pub mod lines;
+pub mod mechanical;
+pub mod predictions;
 pub mod report;
 pub mod signatures;
 pub mod spectrum;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 
-pub use replay::{
-    replay_hydraulics, replay_motor, replay_with, Replay, ReplayError, ReplayKind, ReplayOptions,
-};
-
 /// Why a log could not be diagnosed.
 #[derive(Debug, thiserror::Error)]
 pub enum DiagnoseError {
-    /// The log or the rig cannot be replayed.
+    /// The log breaks the bench-log contract.
     #[error(transparent)]
-    Replay(#[from] ReplayError),
-    /// The log holds nothing the diagnosis can use.
-    #[error("{0}")]
-    Unusable(String),
+    Log(#[from] crate::bench_log::BenchLogError),
+    /// The rig file is invalid.
+    #[error("cannot diagnose on this rig: {0}")]
+    Rig(#[from] plant_model::RigError),
 }
 
 pub use analysis::{analyse, diagnose, Analysis};

@@ -6,7 +6,6 @@
 //! of them are written, so a failure leaves DIR as it was.
 
 use super::analysis::Analysis;
-use super::predict::Predictor;
 use crate::cli::CliError;
 use crate::plots::{line_chart, Marker, Series};
 use std::fmt::Write as _;
@@ -73,11 +72,20 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
     );
     let _ = writeln!(
         md,
-        "| signal | baseline fit [%] | extended fit [%] |\n|---|---|---|"
+        "| signal | residual/noise, baseline | residual/noise, extended | baseline fit [%] | extended fit [%] |\n|---|---|---|---|---|"
     );
-    for (s, b) in &d.baseline.fit_percent_by_signal {
-        let e = d.extended.fit_percent_by_signal.get(s).copied();
-        let _ = writeln!(md, "| `{s}` | {b:.1} | {:.1} |", e.unwrap_or(f64::NAN));
+    let f = |m: &std::collections::BTreeMap<String, f64>, s: &str| {
+        m.get(s).map_or("—".to_string(), |v| format!("{v:.2}"))
+    };
+    for s in d.baseline.fit_percent_by_signal.keys() {
+        let _ = writeln!(
+            md,
+            "| `{s}` | {} | {} | {} | {} |",
+            f(&d.baseline.noise_ratio_by_signal, s),
+            f(&d.extended.noise_ratio_by_signal, s),
+            f(&d.baseline.fit_percent_by_signal, s),
+            f(&d.extended.fit_percent_by_signal, s)
+        );
     }
     let _ = writeln!(
         md,
@@ -129,17 +137,8 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
             );
         }
     }
-    // Traces of the lead cause's signals (pressure and speed when none).
-    let signals: Vec<&'static str> = a
-        .fits
-        .iter()
-        .find(|f| f.candidate.name == lead.effect)
-        .map(|f| f.candidate.predictor.signals().to_vec())
-        .unwrap_or_else(|| {
-            let mut v = Predictor::Hydraulics.signals().to_vec();
-            v.extend(Predictor::Motor.signals());
-            v
-        });
+    // Traces of every predicted signal.
+    let signals: Vec<&'static str> = a.baseline.keys().copied().collect();
     let _ = writeln!(md, "\n## Measured and simulated\n");
     for s in signals {
         let (Some(y), Some(b), Some(e)) = (a.measured.get(s), a.baseline.get(s), a.extended.get(s))

@@ -1,0 +1,321 @@
+//! The catalogue's angle-locked effects fitted to the torque lines of the steady windows
+//! ([`super::lines`]), each a line whose complex amplitude follows a known regressor from
+//! window to window:
+//!
+//! | effect | order | the unexplained torque line is |
+//! |---|---|---|
+//! | cogging | slot order (72) | −T_cog: a constant amplitude (eq. 16) |
+//! | flux harmonics | 6·p_n (24) | −T_6 = −r·T_e: proportional to the mean torque (eq. 19) |
+//! | piston ripple | 2z (18) | −D/2π·(s(θ) − 1)·Δp: proportional to the pressure difference (eq. 20) |
+//! | current-sensor offset | p_n (4) | K_t times the offset's d-q image (the measured current is not the one that flowed) |
+//!
+//! With the angle logged the line's phase is locked to the shaft, and the windows are
+//! combined coherently (weighted least squares of the complex amplitude on the regressor);
+//! without it (the angle integrated from the speed) only their magnitudes are. The
+//! statistic is the generalised likelihood ratio of the line against the noise, whose
+//! variance per window is the neighbouring orders' mean power plus what the tolerances of
+//! K_t and J could leave of the measured current and angle lines ([`TORQUE_TOLERANCE`]):
+//! a voltage disturbance moving current and angle together cannot pass for a torque.
+
+use crate::diagnose::lines::{OrderLines, WindowLines};
+use plant_model::motor::Motor;
+use plant_model::Rig;
+use rustfft::num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// Relative tolerance of the torque constant and the inertia in the torque line. [1]
+pub const TORQUE_TOLERANCE: f64 = 0.1;
+
+/// One of the angle-locked effects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LineEffect {
+    /// A DC offset on a phase-current channel: order p_n.
+    CurrentOffset,
+    /// 5th/7th flux harmonics: order 6·p_n, scaled by the mean torque.
+    FluxHarmonics,
+    /// Cogging at the given order.
+    Cogging(u32),
+    /// The pump's torque ripple of z pistons, scaled by the pressure difference.
+    PistonRipple(u32),
+}
+
+impl LineEffect {
+    /// The catalogue's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            LineEffect::CurrentOffset => "current_sensor_offset",
+            LineEffect::FluxHarmonics => "flux_harmonics",
+            LineEffect::Cogging(_) => "cogging_torque",
+            LineEffect::PistonRipple(_) => "piston_ripple",
+        }
+    }
+
+    /// The order it shows at on `rig`.
+    pub fn order(self, rig: &Rig) -> u32 {
+        let pp = rig.motor.pole_pairs;
+        match self {
+            LineEffect::CurrentOffset => pp,
+            LineEffect::FluxHarmonics => 6 * pp,
+            LineEffect::Cogging(k) => k,
+            LineEffect::PistonRipple(z) => plant_model::pump::ripple_order(z),
+        }
+    }
+}
+
+/// The torque line's regressor in window `w`: what the effect's amplitude multiplies.
+fn regressor(
+    effect: LineEffect,
+    w: &WindowLines,
+    kt: f64,
+    ripple_per_ratio: f64,
+    d_per_rad: f64,
+) -> f64 {
+    match effect {
+        LineEffect::CurrentOffset | LineEffect::Cogging(_) => 1.0,
+        LineEffect::FluxHarmonics => kt * w.iq_mean_a,
+        LineEffect::PistonRipple(_) => ripple_per_ratio * d_per_rad * w.dp_mean_pa,
+    }
+}
+
+/// Noise variance per real component of the torque line `o` in window `w`, the candidate
+/// orders `candidates` left out of its floor.
+pub fn torque_variance(
+    w: &WindowLines,
+    o: &OrderLines,
+    candidates: &[u32],
+    kt: f64,
+    j: f64,
+) -> f64 {
+    let floor = w.floor(o.order, candidates, |x| x.torque);
+    let wk = o.order as f64 * w.window.speed_rad_s.abs();
+    let current = TORQUE_TOLERANCE * kt * o.iq.norm();
+    let angle = TORQUE_TOLERANCE * j * wk * wk * o.theta.norm();
+    floor + 0.5 * (current * current + angle * angle)
+}
+
+/// A line effect fitted on some windows.
+#[derive(Clone, Debug)]
+pub struct LineFit {
+    /// The effect.
+    pub effect: LineEffect,
+    /// Complex amplitude per unit regressor of the unexplained torque line (coherent), or
+    /// its magnitude on the real axis (incoherent). [N·m or 1]
+    pub amplitude: Complex64,
+    /// Generalised likelihood ratio (twice the log-likelihood gain) on the fitted windows.
+    pub lambda: f64,
+    /// Degrees of freedom of `lambda` under no line (2 coherent, 2 per window otherwise).
+    pub dof: usize,
+    /// Windows used.
+    pub windows: usize,
+    /// Whether the phases were combined (the angle was logged).
+    pub coherent: bool,
+}
+
+/// Fits `effect` to the windows `lines` (already restricted to the segment wanted).
+pub fn fit_line(
+    effect: LineEffect,
+    lines: &[&WindowLines],
+    rig: &Rig,
+    kt: f64,
+    j: f64,
+    d_per_rad: f64,
+    candidates: &[u32],
+    coherent: bool,
+) -> Option<LineFit> {
+    let order = effect.order(rig);
+    let ripple_per_ratio = match effect {
+        LineEffect::PistonRipple(z) => super::mechanical::ripple_fundamental_per_ratio(rig, z),
+        _ => 0.0,
+    };
+    let mut data = Vec::new();
+    for w in lines {
+        let Some(o) = w.at(order) else { continue };
+        let var = torque_variance(w, o, candidates, kt, j);
+        let x = regressor(effect, w, kt, ripple_per_ratio, d_per_rad);
+        if var.is_finite() && x.abs() > 0.0 {
+            data.push((o.torque, x, var));
+        }
+    }
+    if data.is_empty() {
+        return None;
+    }
+    let info: f64 = data.iter().map(|(_, x, v)| x * x / v).sum();
+    let (amplitude, lambda, dof) = if coherent {
+        let a = data.iter().map(|(t, x, v)| t * (x / v)).sum::<Complex64>() / info;
+        (a, a.norm_sqr() * info, 2)
+    } else {
+        let a = data
+            .iter()
+            .map(|(t, x, v)| t.norm() * x.abs() / v)
+            .sum::<f64>()
+            / info;
+        let l = data.iter().map(|(t, _, v)| t.norm_sqr() / v).sum::<f64>();
+        (Complex64::new(a, 0.0), l, 2 * data.len())
+    };
+    Some(LineFit {
+        effect,
+        amplitude,
+        lambda,
+        dof,
+        windows: data.len(),
+        coherent,
+    })
+}
+
+/// How much of the line power `fit` predicts in the windows `lines` (the validation
+/// segment's): Σ (|T|² − |T − A·x|²)/σ², positive when the fitted line is there. [1]
+pub fn line_gain(
+    fit: &LineFit,
+    lines: &[&WindowLines],
+    rig: &Rig,
+    kt: f64,
+    j: f64,
+    d_per_rad: f64,
+    candidates: &[u32],
+) -> Option<f64> {
+    let order = fit.effect.order(rig);
+    let ripple_per_ratio = match fit.effect {
+        LineEffect::PistonRipple(z) => super::mechanical::ripple_fundamental_per_ratio(rig, z),
+        _ => 0.0,
+    };
+    let mut gain = 0.0;
+    let mut n = 0;
+    for w in lines {
+        let Some(o) = w.at(order) else { continue };
+        let var = torque_variance(w, o, candidates, kt, j);
+        if !var.is_finite() {
+            continue;
+        }
+        let x = regressor(fit.effect, w, kt, ripple_per_ratio, d_per_rad);
+        let predicted = if fit.coherent {
+            fit.amplitude * x
+        } else {
+            // Only the magnitude is known: the best phase, i.e. the magnitudes compared.
+            o.torque * (fit.amplitude.re * x.abs() / o.torque.norm().max(f64::MIN_POSITIVE))
+        };
+        gain += (o.torque.norm_sqr() - (o.torque - predicted).norm_sqr()) / var;
+        n += 1;
+    }
+    (n > 0).then_some(gain)
+}
+
+/// The current-sensor offset hypotheses: the controller's Clarke transform and the channel
+/// carrying the offset, as (label, direction of the offset's α-β image in degrees, its
+/// magnitude per ampere of offset).
+pub const OFFSET_HYPOTHESES: [(&str, f64, f64); 5] = [
+    ("phase a, three-sensor Clarke", 0.0, 2.0 / 3.0),
+    ("phase b, three-sensor Clarke", 120.0, 2.0 / 3.0),
+    ("phase c, three-sensor Clarke", 240.0, 2.0 / 3.0),
+    // Two sensors (a, b; c = −a − b): α = a, β = (a + 2b)/√3.
+    ("phase a, two-sensor Clarke", 30.0, 1.154_700_538_379_251_5),
+    ("phase b, two-sensor Clarke", 90.0, 1.154_700_538_379_251_5),
+];
+
+/// The offset (signed, A) and its hypothesis from the torque line's complex amplitude `a`
+/// (coherent: phase against the electrical angle p_n·θ_m); without a phase the first
+/// hypothesis (this project's controller) and a positive sign.
+///
+/// The image (α, β) = m·off·(cos φ, sin φ) appears in the measured q current as
+/// m·off·sin(φ − θ_e), i.e. the line K_t·m·off·j·e^{−jφ} against e^{jθ_e}.
+pub fn offset_from_line(a: Complex64, kt: f64, coherent: bool) -> (f64, &'static str) {
+    if !coherent {
+        let (label, _, m) = OFFSET_HYPOTHESES[0];
+        return (a.norm() / (kt * m), label);
+    }
+    let angle = a.arg().to_degrees();
+    let mut best = (f64::INFINITY, 0.0, OFFSET_HYPOTHESES[0].0);
+    for (label, phi, m) in OFFSET_HYPOTHESES {
+        for sign in [1.0, -1.0] {
+            let expected = 90.0 - phi + if sign < 0.0 { 180.0 } else { 0.0 };
+            let d = (angle - expected + 540.0).rem_euclid(360.0) - 180.0;
+            if d.abs() < best.0 {
+                best = (d.abs(), sign * a.norm() / (kt * m), label);
+            }
+        }
+    }
+    (best.1, best.2)
+}
+
+/// The phase of the plant's effect whose unexplained torque line (per unit regressor) is
+/// `a`, found from the plant's own equations: the line the plant makes at phase 0 and at
+/// π/2 fixes the map (it is φ ↦ ±φ + c). [rad]
+pub fn plant_phase(effect: LineEffect, a: Complex64, rig: &Rig) -> f64 {
+    let line_at = |phase: f64| -> Complex64 {
+        let mut r = rig.clone();
+        let e = match effect {
+            LineEffect::Cogging(k) => plant_model::Effect::CoggingTorque {
+                amplitude_nm: 1.0,
+                order: k,
+                phase_rad: phase,
+            },
+            LineEffect::FluxHarmonics => plant_model::Effect::FluxHarmonics {
+                t6_ratio: 0.1,
+                phase_rad: phase,
+            },
+            _ => return Complex64::new(1.0, 0.0),
+        };
+        e.apply(&mut r);
+        let motor = Motor::new(&r.motor);
+        let order = effect.order(rig) as f64;
+        let pp = rig.motor.pole_pairs as f64;
+        let n = 4096;
+        let mut z = Complex64::new(0.0, 0.0);
+        for i in 0..n {
+            let th = 2.0 * PI * i as f64 / n as f64;
+            let torque = match effect {
+                LineEffect::Cogging(_) => motor.cogging_torque_nm(th),
+                _ => motor.torque_nm(0.0, 1.0, &motor.magnet_flux(pp * th)),
+            };
+            // The unexplained torque line is minus the effect's torque.
+            z -= Complex64::from_polar(torque, -order * th);
+        }
+        z * (2.0 / n as f64)
+    };
+    let (z0, z1) = (line_at(0.0), line_at(PI / 2.0));
+    if z0.norm() == 0.0 {
+        return 0.0;
+    }
+    // Rotation per radian of phase: +1 or −1.
+    let turn = (z1 / z0).arg();
+    let s = if turn >= 0.0 { 1.0 } else { -1.0 };
+    wrap_pi(s * (a / z0).arg())
+}
+
+/// Wraps an angle to (−π, π]. [rad]
+pub fn wrap_pi(a: f64) -> f64 {
+    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
+    if w <= -PI {
+        w + 2.0 * PI
+    } else {
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_offset_on_phase_a_of_a_three_sensor_controller_reads_back() {
+        // Offset 0.3 A on phase a, three-sensor Clarke: image (0.2, 0) A; the measured q
+        // current carries 0.2·sin(−θ_e), the line j·0.2·K_t against e^{jθ_e}.
+        let kt = 1.0962;
+        let a = Complex64::new(0.0, 0.2 * kt);
+        let (off, label) = offset_from_line(a, kt, true);
+        assert!((off - 0.3).abs() < 1e-9, "{off}");
+        assert!(label.contains("phase a, three"), "{label}");
+        let (off, _) = offset_from_line(-a, kt, true);
+        assert!((off + 0.3).abs() < 1e-9, "{off}");
+    }
+
+    #[test]
+    fn a_two_sensor_offset_is_told_by_its_phase() {
+        // Two sensors, offset 0.2 A on phase a: α = 0.2, β = 0.2/√3, image 0.2309 A at 30°.
+        let kt = 1.0;
+        let m = 0.2 * 2.0 / 3f64.sqrt();
+        let a = Complex64::from_polar(m, (60f64).to_radians());
+        let (off, label) = offset_from_line(a, kt, true);
+        assert!((off - 0.2).abs() < 1e-9, "{off}");
+        assert!(label.contains("two-sensor"), "{label}");
+    }
+}

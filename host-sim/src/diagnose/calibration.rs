@@ -1,0 +1,470 @@
+//! Calibration before accusation: each parity relation's parameters fitted to the log
+//! within the rig's tolerance bands (Gaussian priors, [`super::least_squares`]), and the
+//! same fit with one effect's parameter released to its physically plausible range.
+//!
+//! The bands, as fractions of the rig file's value (or absolute where the nominal is 0):
+//!
+//! | parameter | band | why |
+//! |---|---|---|
+//! | high-side volume V_h | −3 % … +30 % | chamber listed ±2 %; the line volume is not listed |
+//! | bulk modulus β | ±5 % | listed ±2 %; temperature moves it a few percent |
+//! | absorber shell V_0, precharge p_0 | ±5 % | listed ±2 % |
+//! | absorber inlet resistance R | ÷10 … ×30 | not listed (inlet, hose and bladder) |
+//! | leakage G (pump and cylinder) | ±20 % | coefficients listed; the path (eq. 9 or 10) not |
+//! | transducer gain, offset, lag | ±1 %, ±30 kPa, 0–2.5 ms | a calibrated transducer behind a snubber and an anti-aliasing filter |
+//! | magnet flux ψ_f (K_t) | ±5 % | listed ±2 %; magnet temperature |
+//! | inertia J | ±10 % | assumed in the rig contract |
+//! | viscous friction B | ÷2 … ×2 | assumed in the rig contract |
+//! | shaft Coulomb friction T_c | 0 … 0.02 N·m | seals and bearings of a healthy shaft |
+//! | pump displacement D | ±5 % | listed ±2 % |
+//! | saliency (reluctance torque) | 0 … 1.2 of the rig's | L_d, L_q derived from gains |
+//!
+//! The pump displacement is fixed at its rig value in the hydraulic relation: every volume
+//! there is relative to it (scaling D and all volumes together leaves p(θ) unchanged), so
+//! the volumes carry the tolerance.
+
+use crate::bench_log::{BenchLog, Signal};
+use crate::diagnose::facts::LogFacts;
+use crate::diagnose::hydraulic::{HydraulicInputs, HydraulicParams, Hydraulics};
+use crate::diagnose::least_squares::{
+    fit, huber, variance_per_independent_sample, Fitted, ParamSpec,
+};
+use crate::diagnose::mechanical::{MechanicalParams, Mechanics, ShaftMotion};
+use plant_model::accumulator::GasCharge;
+use plant_model::Rig;
+use std::ops::Range;
+
+/// Upper end of the transducer lag's tolerance band: a transducer with its snubber and
+/// the logger's anti-aliasing filter. [s]
+pub const LAG_BAND_S: f64 = 2.5e-3;
+
+/// Upper end of a healthy shaft's Coulomb friction (bearings and seals). [N·m]
+pub const SHAFT_COULOMB_BAND_NM: f64 = 0.02;
+
+/// Length of a hydraulic shooting window. [s]
+pub const HYDRAULIC_WINDOW_S: f64 = 0.25;
+
+/// Length of a speed shooting window. [s]
+pub const SPEED_WINDOW_S: f64 = 0.05;
+
+/// Most rows a fit evaluates per model run: longer segments are thinned to evenly spread
+/// windows (a 600 s log is calibrated on a tenth of its first half). [1]
+pub const MAX_FIT_ROWS: usize = 40_000;
+
+/// Which parameter of a relation an effect releases from its band.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Release {
+    /// None: the calibrated nominal model.
+    Nothing,
+    /// Leakage G upward (extra leakage).
+    Leakage,
+    /// Bulk modulus β downward (entrained air).
+    BulkModulus,
+    /// Absorber precharge p_0 (gas loss or overcharge).
+    Precharge,
+    /// Transducer lag τ.
+    SensorLag,
+    /// Shaft Coulomb friction.
+    ShaftFriction,
+    /// Inverter dead time (electrical relation).
+    DeadTime,
+    /// Cylinder Coulomb friction.
+    CylinderFriction,
+}
+
+/// Index of each hydraulic parameter in the search vector.
+pub mod hyd {
+    /// High-side volume.
+    pub const VOLUME: usize = 0;
+    /// Bulk modulus.
+    pub const BETA: usize = 1;
+    /// Absorber shell volume.
+    pub const SHELL: usize = 2;
+    /// Absorber precharge.
+    pub const PRECHARGE: usize = 3;
+    /// Absorber inlet resistance.
+    pub const RESISTANCE: usize = 4;
+    /// Leakage.
+    pub const LEAKAGE: usize = 5;
+    /// Transducer gain.
+    pub const GAIN: usize = 6;
+    /// Transducer offset.
+    pub const OFFSET: usize = 7;
+    /// Transducer lag.
+    pub const LAG: usize = 8;
+}
+
+/// Index of each mechanical parameter in the search vector.
+pub mod mech {
+    /// Magnet flux linkage (the torque constant's scale).
+    pub const PSI: usize = 0;
+    /// Inertia.
+    pub const INERTIA: usize = 1;
+    /// Viscous friction.
+    pub const VISCOUS: usize = 2;
+    /// Coulomb friction.
+    pub const COULOMB: usize = 3;
+    /// Pump displacement.
+    pub const DISPLACEMENT: usize = 4;
+    /// Fraction of the rig's saliency.
+    pub const SALIENCY: usize = 5;
+}
+
+/// The hydraulic relation's search space on `rig`, with `release` out of its band.
+pub fn hydraulic_specs(rig: &Rig, release: Release) -> Vec<ParamSpec> {
+    let n = HydraulicParams::nominal(rig);
+    let gas = n.absorber.unwrap_or(GasCharge {
+        shell_volume_m3: 1e-4,
+        precharge_pa: 1e6,
+        exponent: 1.3,
+    });
+    let banded = |s: ParamSpec, lo: f64, hi: f64, released: bool| {
+        if released {
+            s
+        } else {
+            let nom = s.nominal;
+            s.with_band(lo * nom, hi * nom)
+        }
+    };
+    let mut lag = ParamSpec::linear("sensor_lag_s", 0.0, 1e-3, 0.0, 0.2);
+    if release != Release::SensorLag {
+        lag = lag.with_band(0.0, LAG_BAND_S);
+    } else {
+        lag = lag.starting_at(5e-3);
+    }
+    vec![
+        banded(
+            ParamSpec::log("high_side_volume_m3", n.high_side_volume_m3, 0.3, 3.0),
+            0.97,
+            1.3,
+            false,
+        ),
+        banded(
+            ParamSpec::log("bulk_modulus_pa", n.bulk_modulus_pa, 0.05, 1.5),
+            0.95,
+            1.05,
+            release == Release::BulkModulus,
+        ),
+        banded(
+            ParamSpec::log("shell_volume_m3", gas.shell_volume_m3, 0.3, 3.0),
+            0.95,
+            1.05,
+            false,
+        ),
+        banded(
+            ParamSpec::log("precharge_pa", gas.precharge_pa, 0.1, 5.0),
+            0.95,
+            1.05,
+            release == Release::Precharge,
+        ),
+        banded(
+            ParamSpec::log(
+                "inlet_resistance_pa_s_m3",
+                n.inlet_resistance_pa_s_m3.max(1.0),
+                0.01,
+                100.0,
+            ),
+            0.1,
+            30.0,
+            false,
+        ),
+        if release == Release::Leakage {
+            // Extra leakage: only more than the band allows.
+            ParamSpec::log("leakage_m3_s_pa", n.leakage_m3_s_pa.max(1e-16), 0.8, 30.0)
+                .starting_at(1.5 * n.leakage_m3_s_pa)
+        } else {
+            ParamSpec::log("leakage_m3_s_pa", n.leakage_m3_s_pa.max(1e-16), 0.05, 30.0)
+                .with_band(0.8 * n.leakage_m3_s_pa, 1.2 * n.leakage_m3_s_pa)
+        },
+        ParamSpec::linear("sensor_gain", 1.0, 0.01, 0.8, 1.2).with_band(0.99, 1.01),
+        ParamSpec::linear("sensor_offset_pa", n.sensor_offset_pa, 1e4, -1e6, 1e6)
+            .with_band(n.sensor_offset_pa - 3e4, n.sensor_offset_pa + 3e4),
+        lag,
+    ]
+}
+
+/// The hydraulic parameters at search `values` ([`hydraulic_specs`] order).
+pub fn hydraulic_params(rig: &Rig, v: &[f64]) -> HydraulicParams {
+    let mut p = HydraulicParams::nominal(rig);
+    p.high_side_volume_m3 = v[hyd::VOLUME];
+    p.bulk_modulus_pa = v[hyd::BETA];
+    if let Some(g) = p.absorber.as_mut() {
+        g.shell_volume_m3 = v[hyd::SHELL];
+        g.precharge_pa = v[hyd::PRECHARGE];
+    }
+    p.inlet_resistance_pa_s_m3 = v[hyd::RESISTANCE];
+    p.leakage_m3_s_pa = v[hyd::LEAKAGE];
+    p.sensor_gain = v[hyd::GAIN];
+    p.sensor_offset_pa = v[hyd::OFFSET];
+    p.sensor_lag_s = v[hyd::LAG];
+    p
+}
+
+/// Evenly thinned `windows` holding at most [`MAX_FIT_ROWS`] rows together.
+pub fn thinned(windows: Vec<Range<usize>>) -> Vec<Range<usize>> {
+    let rows: usize = windows.iter().map(|w| w.len()).sum();
+    if rows <= MAX_FIT_ROWS {
+        return windows;
+    }
+    let keep = (windows.len() * MAX_FIT_ROWS / rows).max(1);
+    let step = windows.len() as f64 / keep as f64;
+    (0..keep)
+        .filter_map(|i| windows.get((i as f64 * step) as usize).cloned())
+        .collect()
+}
+
+/// The hydraulic relation's residuals (measured − predicted pressure over its noise) over
+/// `windows`, each window's first row left out (it is the start).
+pub fn hydraulic_residuals(
+    log: &BenchLog,
+    facts: &LogFacts,
+    rig: &Rig,
+    params: HydraulicParams,
+    windows: &[Range<usize>],
+) -> Vec<f64> {
+    let sigma = facts.noise(Signal::Pressure).unwrap_or(1.0).max(1.0);
+    let model = Hydraulics::new(params, rig);
+    let inputs = HydraulicInputs::of(log, facts);
+    let mut pred = vec![0.0; facts.rows];
+    model.predict(&inputs, windows, &mut pred);
+    windows
+        .iter()
+        .flat_map(|w| {
+            (w.start + 1..w.end)
+                .map(|k| huber((log.p_pa[k] - pred[k]) / sigma))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// The mechanical relation's search space on `rig`.
+pub fn mechanical_specs(rig: &Rig, release: Release) -> Vec<ParamSpec> {
+    let n = MechanicalParams::nominal(rig);
+    let mut coulomb = ParamSpec::linear("coulomb_nm", n.coulomb_nm, 0.01, 0.0, 2.0);
+    if release != Release::ShaftFriction {
+        coulomb = coulomb.with_band(n.coulomb_nm, n.coulomb_nm + SHAFT_COULOMB_BAND_NM);
+    } else {
+        coulomb = coulomb.starting_at(0.1);
+    }
+    let psi = n.motor.psi_f_wb;
+    let d = n.pump.displacement_m3_per_rev;
+    vec![
+        ParamSpec::log("psi_f_wb", psi, 0.5, 2.0).with_band(0.95 * psi, 1.05 * psi),
+        ParamSpec::log("inertia_kg_m2", n.inertia_kg_m2, 0.2, 5.0)
+            .with_band(0.9 * n.inertia_kg_m2, 1.1 * n.inertia_kg_m2),
+        ParamSpec::log("viscous_nm_s", n.viscous_nm_s.max(1e-6), 0.01, 100.0)
+            .with_band(0.5 * n.viscous_nm_s, 2.0 * n.viscous_nm_s),
+        coulomb,
+        ParamSpec::log("displacement_m3_per_rev", d, 0.5, 2.0).with_band(0.95 * d, 1.05 * d),
+        // The fraction of the rig's saliency L_d − L_q present (eq. 3's reluctance torque):
+        // the saliency the Table 1 gains imply, which a motor may have less of.
+        ParamSpec::linear("saliency_fraction", 1.0, 0.1, -0.5, 1.5).with_band(0.0, 1.2),
+    ]
+}
+
+/// The mechanical parameters at search `values` ([`mechanical_specs`] order).
+pub fn mechanical_params(rig: &Rig, v: &[f64]) -> MechanicalParams {
+    let mut p = MechanicalParams::nominal(rig);
+    p.motor.psi_f_wb = v[mech::PSI];
+    p.inertia_kg_m2 = v[mech::INERTIA];
+    p.viscous_nm_s = v[mech::VISCOUS];
+    p.coulomb_nm = v[mech::COULOMB];
+    p.pump.displacement_m3_per_rev = v[mech::DISPLACEMENT];
+    p.motor.l_d_h = p.motor.l_q_h + v[mech::SALIENCY] * (p.motor.l_d_h - p.motor.l_q_h);
+    p
+}
+
+/// The mechanical relation's residuals (logged − needed q current over its noise) over
+/// `rows`.
+pub fn mechanical_residuals(
+    log: &BenchLog,
+    facts: &LogFacts,
+    motion: &ShaftMotion,
+    params: MechanicalParams,
+    rows: &[Range<usize>],
+) -> Vec<f64> {
+    let sigma = facts.noise(Signal::Iq).unwrap_or(1.0).max(1e-6);
+    let model = Mechanics::new(params);
+    let mut pred = vec![0.0; facts.rows];
+    let mut out = Vec::new();
+    for r in rows {
+        model.needed_current(log, facts, motion, r.clone(), &mut pred);
+        out.extend(r.clone().map(|k| huber((log.iq_a[k] - pred[k]) / sigma)));
+    }
+    out
+}
+
+/// A parity relation the calibration fits: its search space and its residuals.
+pub trait Relation: Sync {
+    /// The search space with `release` out of its band.
+    fn specs(&self, release: Release) -> Vec<ParamSpec>;
+    /// Robust residuals (noise units, [`huber`]) at search `values` over `rows`.
+    fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64>;
+}
+
+/// The hydraulic relation of a log.
+pub struct HydraulicRelation<'a> {
+    /// The log.
+    pub log: &'a BenchLog,
+    /// Its facts.
+    pub facts: &'a LogFacts,
+    /// The rig file.
+    pub rig: &'a Rig,
+}
+
+impl Relation for HydraulicRelation<'_> {
+    fn specs(&self, release: Release) -> Vec<ParamSpec> {
+        hydraulic_specs(self.rig, release)
+    }
+
+    fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
+        hydraulic_residuals(
+            self.log,
+            self.facts,
+            self.rig,
+            hydraulic_params(self.rig, values),
+            rows,
+        )
+    }
+}
+
+/// The mechanical relation of a log.
+pub struct MechanicalRelation<'a> {
+    /// The log.
+    pub log: &'a BenchLog,
+    /// Its facts.
+    pub facts: &'a LogFacts,
+    /// The shaft's motion.
+    pub motion: &'a ShaftMotion,
+    /// The rig file.
+    pub rig: &'a Rig,
+}
+
+impl Relation for MechanicalRelation<'_> {
+    fn specs(&self, release: Release) -> Vec<ParamSpec> {
+        mechanical_specs(self.rig, release)
+    }
+
+    fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
+        mechanical_residuals(
+            self.log,
+            self.facts,
+            self.motion,
+            mechanical_params(self.rig, values),
+            rows,
+        )
+    }
+}
+
+/// A relation calibrated on some rows: the fit and the residuals' variance per independent
+/// sample it was weighed with ([`variance_per_independent_sample`]).
+#[derive(Clone, Debug)]
+pub struct Calibration {
+    /// The fit (its `data_sse` in units of `scale`).
+    pub fitted: Fitted,
+    /// Variance per independent sample of the calibrated residuals. [noise units²]
+    pub scale: f64,
+}
+
+/// Fits `relation` over `rows` with `release`, its residuals divided by √`scale`, from
+/// `start` (values) when given.
+pub fn fit_relation<R: Relation>(
+    relation: &R,
+    rows: &[Range<usize>],
+    release: Release,
+    scale: f64,
+    start: Option<&[f64]>,
+) -> Fitted {
+    let mut specs = relation.specs(release);
+    if let Some(v) = start {
+        for (s, v) in specs.iter_mut().zip(v) {
+            let (lo, hi) = s.u_bounds;
+            s.start = s.coordinate(*v).clamp(lo, hi);
+        }
+    }
+    let w = 1.0 / scale.max(f64::MIN_POSITIVE).sqrt();
+    let model = |v: &[f64]| -> Vec<f64> {
+        let mut r = relation.residuals(v, rows);
+        r.iter_mut().for_each(|x| *x *= w);
+        r
+    };
+    fit(&model, &specs)
+}
+
+/// Calibrates `relation` within its bands over `rows`: weighed first by the nominal
+/// model's residuals, then again by the calibrated model's.
+pub fn calibrate<R: Relation>(relation: &R, rows: &[Range<usize>]) -> Calibration {
+    let specs = relation.specs(Release::Nothing);
+    let nominal: Vec<f64> = specs.iter().map(|s| s.value(s.start)).collect();
+    let scale0 = variance_per_independent_sample(&relation.residuals(&nominal, rows));
+    let first = fit_relation(relation, rows, Release::Nothing, scale0, None);
+    let scale = variance_per_independent_sample(&relation.residuals(&first.values, rows));
+    let fitted = fit_relation(relation, rows, Release::Nothing, scale, Some(&first.values));
+    Calibration { fitted, scale }
+}
+
+/// One effect's test on a relation: its parameter released from its band against the
+/// calibrated nominal model, both weighed by the released model's residuals (the variance
+/// of the larger model, as an F test takes it).
+#[derive(Clone, Debug)]
+pub struct ReleaseTest {
+    /// What was released.
+    pub release: Release,
+    /// The released fit.
+    pub fitted: Fitted,
+    /// The calibrated nominal model refitted at the same weighing.
+    pub baseline: Fitted,
+    /// Variance per independent sample of the released model's residuals. [noise units²]
+    pub scale: f64,
+    /// Twice the log-likelihood ratio, J_baseline − J_released (objective incl. priors). [1]
+    pub lambda: f64,
+}
+
+/// Tests `release` on `relation` over `rows`, from the calibration `base`.
+pub fn test_release<R: Relation>(
+    relation: &R,
+    rows: &[Range<usize>],
+    release: Release,
+    base: &Calibration,
+) -> ReleaseTest {
+    let first = fit_relation(
+        relation,
+        rows,
+        release,
+        base.scale,
+        Some(&base.fitted.values),
+    );
+    let scale =
+        variance_per_independent_sample(&relation.residuals(&first.values, rows)).min(base.scale);
+    let fitted = fit_relation(relation, rows, release, scale, Some(&first.values));
+    let baseline = fit_relation(
+        relation,
+        rows,
+        Release::Nothing,
+        scale,
+        Some(&base.fitted.values),
+    );
+    let objective = |f: &Fitted| f.data_sse + f.prior_sse;
+    ReleaseTest {
+        release,
+        lambda: (objective(&baseline) - objective(&fitted)).max(0.0),
+        fitted,
+        baseline,
+        scale,
+    }
+}
+
+/// The weighed squared residuals of `relation` at `values` over `rows`. [1]
+pub fn weighed_sse<R: Relation>(
+    relation: &R,
+    values: &[f64],
+    rows: &[Range<usize>],
+    scale: f64,
+) -> f64 {
+    relation
+        .residuals(values, rows)
+        .iter()
+        .map(|r| r * r)
+        .sum::<f64>()
+        / scale.max(f64::MIN_POSITIVE)
+}

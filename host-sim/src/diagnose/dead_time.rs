@@ -1,0 +1,212 @@
+//! Inverter dead time from the current lines, for logs without stator voltages.
+//!
+//! The dead time's voltage error (the plant's [`Inverter`]: each leg loses a voltage
+//! against its current's sign, faded within a current band) has, in d-q, a constant part the
+//! current PIs integrate away and a sixth-harmonic part (order 6·p_n of the shaft) they
+//! only partly reject: a voltage U_6 on an axis of inductance L and resistance R under a PI
+//! of gains K_p, K_i leaves the current line
+//!
+//! ```text
+//!   I_6 = U_6 · s / (L·s² + (R + K_p)·s + K_i),   s = j·6·ω_e
+//! ```
+//!
+//! (the loop's disturbance sensitivity, Table 1's gains from the rig). Along q the current
+//! vector makes U_6 mostly a d-axis voltage, so the d current carries the dead time's
+//! line while a torque effect at the same order (flux harmonics) shows in the torque balance
+//! instead ([`super::angle_locked`]).
+//!
+//! The fit: per steady window the model's line magnitudes |I_d|, |I_q| per unit dead time at
+//! the window's current and speed, the measured ones by weighted least squares, the fade
+//! band searched over a grid (it is not in the rig contract).
+
+use crate::diagnose::lines::WindowLines;
+use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
+use plant_model::Rig;
+use rustfft::num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// Dead time the model's lines are computed for (they scale with it). [s]
+pub const REFERENCE_DEAD_TIME_S: f64 = 1e-6;
+
+/// Current bands of the dead-time error's fade tried. [A]
+pub const BANDS_A: [f64; 7] = [0.01, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8];
+
+/// The dead time's sixth-harmonic d-q voltage at current (i_d, i_q) for `band`, per
+/// [`REFERENCE_DEAD_TIME_S`]: the plant's inverter over one electrical turn. [V]
+pub fn sixth_harmonic_voltage(rig: &Rig, i_d: f64, i_q: f64, band: f64) -> (Complex64, Complex64) {
+    let mut p = rig.inverter.clone();
+    p.dead_time_s = REFERENCE_DEAD_TIME_S;
+    p.dead_time_current_band_a = band.max(1e-6);
+    let inv = Inverter::new(&p);
+    let n = 720;
+    let (mut d, mut q) = (Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+    for k in 0..n {
+        let th = 2.0 * PI * k as f64 / n as f64;
+        let (s, c) = th.sin_cos();
+        let v = inv.pole_voltages(&[0.0; 3], &dq_to_abc(i_d, i_q, s, c));
+        let (ud, uq) = pole_to_dq(&v, s, c);
+        let e = Complex64::from_polar(2.0 / n as f64, -6.0 * th);
+        d += e * ud;
+        q += e * uq;
+    }
+    (d, q)
+}
+
+/// The current loops' disturbance sensitivity on (d, q) at angular frequency `w`. [A/V]
+pub fn disturbance_sensitivity(rig: &Rig, w: f64) -> (Complex64, Complex64) {
+    let c = closed_loop::controller_config(rig).current;
+    let m = &rig.motor;
+    let s = Complex64::new(0.0, w);
+    let h = |l: f64, kp: f64, ki: f64| s / (s * s * l + s * (m.r_s_ohm + kp) + ki);
+    (
+        h(m.l_d_h, c.kp_d as f64, c.ki_d as f64),
+        h(m.l_q_h, c.kp_q as f64, c.ki_q as f64),
+    )
+}
+
+/// A dead-time fit.
+#[derive(Clone, Debug)]
+pub struct DeadTimeFit {
+    /// Dead time. [s]
+    pub dead_time_s: f64,
+    /// The fade band that fits best. [A]
+    pub band_a: f64,
+    /// Line power explained (twice the log-likelihood gain). [1]
+    pub lambda: f64,
+    /// Windows used.
+    pub windows: usize,
+}
+
+/// One window's measured and modelled line magnitudes with their noise variances.
+struct Obs {
+    measured: [f64; 2],
+    model: [f64; 2],
+    var: [f64; 2],
+}
+
+fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]) -> Vec<Obs> {
+    let pp = rig.motor.pole_pairs;
+    let order = 6 * pp;
+    lines
+        .iter()
+        .filter_map(|w| {
+            let o = w.at(order)?;
+            let var_d = w.floor(order, candidates, |x| x.id);
+            let var_q = w.floor(order, candidates, |x| x.iq);
+            if !(var_d.is_finite() && var_q.is_finite()) {
+                return None;
+            }
+            let (ed, eq) = sixth_harmonic_voltage(rig, 0.0, w.iq_mean_a, band);
+            let w6 = 6.0 * pp as f64 * w.window.speed_rad_s.abs();
+            let (hd, hq) = disturbance_sensitivity(rig, w6);
+            Some(Obs {
+                measured: [o.id.norm(), o.iq.norm()],
+                model: [(hd * ed).norm(), (hq * eq).norm()],
+                var: [var_d, var_q],
+            })
+        })
+        .collect()
+}
+
+/// Fits the dead time to the d and q current lines at order 6·p_n of `lines`.
+pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> Option<DeadTimeFit> {
+    let mut best: Option<DeadTimeFit> = None;
+    for band in BANDS_A {
+        let obs = observations(lines, rig, band, candidates);
+        if obs.is_empty() {
+            return None;
+        }
+        let (mut num, mut den, mut power) = (0.0, 0.0, 0.0);
+        for o in &obs {
+            for a in 0..2 {
+                num += o.measured[a] * o.model[a] / o.var[a];
+                den += o.model[a] * o.model[a] / o.var[a];
+                power += o.measured[a] * o.measured[a] / o.var[a];
+            }
+        }
+        if den <= 0.0 {
+            continue;
+        }
+        let scale = (num / den).max(0.0);
+        let resid: f64 = obs
+            .iter()
+            .flat_map(|o| {
+                (0..2).map(move |a| (o.measured[a] - scale * o.model[a]).powi(2) / o.var[a])
+            })
+            .sum();
+        let fit = DeadTimeFit {
+            dead_time_s: scale * REFERENCE_DEAD_TIME_S,
+            band_a: band,
+            lambda: (power - resid).max(0.0),
+            windows: obs.len(),
+        };
+        if best.as_ref().is_none_or(|b| fit.lambda > b.lambda) {
+            best = Some(fit);
+        }
+    }
+    best
+}
+
+/// The line power `fit` explains in the windows `lines`. [1]
+pub fn dead_time_gain(
+    fit: &DeadTimeFit,
+    lines: &[&WindowLines],
+    rig: &Rig,
+    candidates: &[u32],
+) -> Option<f64> {
+    let obs = observations(lines, rig, fit.band_a, candidates);
+    if obs.is_empty() {
+        return None;
+    }
+    let scale = fit.dead_time_s / REFERENCE_DEAD_TIME_S;
+    Some(
+        obs.iter()
+            .flat_map(|o| {
+                (0..2).map(move |a| {
+                    (o.measured[a].powi(2) - (o.measured[a] - scale * o.model[a]).powi(2))
+                        / o.var[a]
+                })
+            })
+            .sum(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_loops_reject_a_slow_disturbance_and_pass_a_fast_one_through_the_winding() {
+        // Far below the loop bandwidth the sensitivity is s/K_i; far above, 1/(L·s).
+        let rig = Rig::nominal();
+        let c = closed_loop::controller_config(&rig).current;
+        let (hd, _) = disturbance_sensitivity(&rig, 1.0);
+        assert!((hd.norm() - 1.0 / c.ki_d as f64).abs() < 0.01 / c.ki_d as f64);
+        let (hd, _) = disturbance_sensitivity(&rig, 1e6);
+        assert!((hd.norm() * rig.motor.l_d_h * 1e6 - 1.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn a_square_wave_dead_time_error_has_the_textbook_sixth_harmonic() {
+        // Far above the fade band each phase loses V·sign(i), a square wave with harmonics
+        // (4/π)·V/h; in d-q along q its 5th and 7th become the sixth, adding on the d axis,
+        // (4/π)·V·(1/5 + 1/7), and subtracting on q, (4/π)·V·(1/5 − 1/7).
+        let rig = Rig::nominal();
+        let (d, q) = sixth_harmonic_voltage(&rig, 0.0, 100.0, 0.01);
+        let mut p = rig.inverter.clone();
+        p.dead_time_s = REFERENCE_DEAD_TIME_S;
+        let leg = Inverter::new(&p).pole_voltages(&[0.0; 3], &[100.0, -50.0, -50.0])[0].abs();
+        let expected = 4.0 / PI * leg * 12.0 / 35.0;
+        assert!(
+            (d.norm() / expected - 1.0).abs() < 0.02,
+            "{} vs {expected}",
+            d.norm()
+        );
+        let expected_q = 4.0 / PI * leg * 2.0 / 35.0;
+        assert!(
+            (q.norm() / expected_q - 1.0).abs() < 0.05,
+            "{} vs {expected_q}",
+            q.norm()
+        );
+    }
+}

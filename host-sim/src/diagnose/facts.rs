@@ -1,0 +1,329 @@
+//! Facts about a bench log, computed once before any model runs: its sampling, the shaft
+//! angle (logged, else integrated from the logged speed), the low-side pressure (logged,
+//! else the rig's fill pressure), whether the piston moves, each signal's noise level, the
+//! identification and validation segments, and the stretches of steady rotation where
+//! angle-locked lines can be measured.
+//!
+//! Every later stage reads these instead of asking the log again.
+
+use crate::bench_log::{BenchLog, Signal};
+use plant_model::Rig;
+use std::f64::consts::PI;
+use std::ops::Range;
+
+/// Piston travel above which the log shows the piston moving (well above a linear
+/// transducer's noise, well below the slowest stroke's travel). [m]
+pub const MOVING_PISTON_TRAVEL_M: f64 = 0.2e-3;
+
+/// Shortest steady-rotation window for the angle-locked lines. [s]
+pub const STEADY_WINDOW_S: f64 = 1.0;
+
+/// Longest steady-rotation window: at a slow holding speed it takes a few seconds to turn
+/// [`STEADY_MIN_REVOLUTIONS`]. [s]
+pub const STEADY_MAX_S: f64 = 4.0;
+
+/// Chunk whose mean speed the steady windows are built from. [s]
+pub const STEADY_CHUNK_S: f64 = 0.25;
+
+/// Largest departure of a chunk's mean speed from its window's mean, relative to it. [1]
+pub const STEADY_SPREAD: f64 = 0.1;
+
+/// Fewest mechanical revolutions a steady window must hold for its lines to be resolved
+/// (order k and k ± 1 are then apart by a whole cycle per revolution). [1]
+pub const STEADY_MIN_REVOLUTIONS: f64 = 2.0;
+
+/// Fraction of the largest second differences left out of the noise estimate (steps and
+/// transients, not noise). [1]
+const NOISE_TRIM: f64 = 0.02;
+
+/// Variance a Gaussian keeps when its 2 % largest magnitudes are left out (the two-sided
+/// 98 % quantile q = 2.326: 1 − 2·q·φ(q)/0.98); the trimmed estimate is divided by it. [1]
+const NOISE_TRIM_VARIANCE: f64 = 0.8735;
+
+/// A stretch of steady rotation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SteadyWindow {
+    /// Rows.
+    pub rows: Range<usize>,
+    /// Mean shaft speed (signed). [rad/s]
+    pub speed_rad_s: f64,
+    /// Revolutions turned. [1]
+    pub revolutions: f64,
+}
+
+/// Everything about the log that does not depend on a model.
+#[derive(Clone, Debug)]
+pub struct LogFacts {
+    /// Rows.
+    pub rows: usize,
+    /// Median sampling interval. [s]
+    pub period_s: f64,
+    /// Shaft angle, unwrapped: the logged one or the logged speed integrated. [rad]
+    pub theta_rad: Vec<f64>,
+    /// Whether `theta_rad` was logged (else integrated, so its absolute phase is unknown).
+    pub angle_logged: bool,
+    /// Low-side (port B) pressure: logged, or the rig's fill pressure. [Pa]
+    pub p_low_pa: Vec<f64>,
+    /// Whether the piston moves (`x_m` logged and travelling).
+    pub piston_moves: bool,
+    /// First row of the validation segment (identification is `0..split`).
+    pub split: usize,
+    /// Noise RMS per logged signal, from the trimmed second differences. [unit]
+    pub noise_rms: Vec<(Signal, f64)>,
+    /// Steady-rotation windows (speed nearly constant, at least
+    /// [`STEADY_MIN_REVOLUTIONS`]), in time order.
+    pub steady: Vec<SteadyWindow>,
+}
+
+impl LogFacts {
+    /// The facts of a checked `log` (at least a few rows, time increasing) on `rig`.
+    pub fn of(log: &BenchLog, rig: &Rig) -> LogFacts {
+        let rows = log.len();
+        let t = &log.t_s;
+        let period_s = median_period(t);
+        let (theta_rad, angle_logged) = match log.theta_m_rad.as_deref() {
+            Some(th) => (unwrap_angle(th), true),
+            None => (integrated_angle(t, &log.speed_rad_s), false),
+        };
+        let p_low_pa = log
+            .p_low_pa
+            .clone()
+            .unwrap_or_else(|| vec![rig.fill.pressure_pa; rows]);
+        let piston_moves = log.x_m.as_deref().is_some_and(|x| {
+            let (lo, hi) = x
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                    (l.min(*v), h.max(*v))
+                });
+            hi - lo > MOVING_PISTON_TRAVEL_M
+        });
+        let t_half = t[0] + 0.5 * (t[rows - 1] - t[0]);
+        let split = t.partition_point(|x| *x < t_half).clamp(1, rows - 1);
+        let noise_rms = log
+            .columns()
+            .filter(|(s, _)| *s != Signal::Time)
+            .map(|(s, y)| (s, noise_rms(y)))
+            .collect();
+        let steady = steady_windows(t, &theta_rad, period_s);
+        LogFacts {
+            rows,
+            period_s,
+            theta_rad,
+            angle_logged,
+            p_low_pa,
+            piston_moves,
+            split,
+            noise_rms,
+            steady,
+        }
+    }
+
+    /// The noise RMS of `signal` (its unit), if logged.
+    pub fn noise(&self, signal: Signal) -> Option<f64> {
+        self.noise_rms
+            .iter()
+            .find(|(s, _)| *s == signal)
+            .map(|(_, v)| *v)
+    }
+
+    /// Identification rows.
+    pub fn identification(&self) -> Range<usize> {
+        0..self.split
+    }
+
+    /// Validation rows.
+    pub fn validation(&self) -> Range<usize> {
+        self.split..self.rows
+    }
+
+    /// Consecutive windows of about `length_s` covering `rows` (the last one absorbs a
+    /// remainder shorter than half a window), each at least two rows.
+    pub fn windows(&self, rows: Range<usize>, length_s: f64) -> Vec<Range<usize>> {
+        let len = ((length_s / self.period_s).round() as usize).max(2);
+        let mut out = Vec::new();
+        let mut start = rows.start;
+        while start + 1 < rows.end {
+            let mut end = (start + len).min(rows.end);
+            if rows.end - end < len / 2 {
+                end = rows.end;
+            }
+            out.push(start..end);
+            start = end;
+        }
+        out
+    }
+}
+
+/// Median of the sampling intervals of `t` (at least two rows). [s]
+fn median_period(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    d.sort_by(f64::total_cmp);
+    d.get(d.len() / 2)
+        .copied()
+        .unwrap_or(1e-3)
+        .max(f64::MIN_POSITIVE)
+}
+
+/// Noise RMS of a signal from its second differences, which cancel any trend and slope:
+/// for white noise of variance σ², Δ²y has variance 6σ². The largest [`NOISE_TRIM`] of them
+/// (steps, the start of a ramp) are left out and the Gaussian's loss from the trimming is
+/// given back. A quantised signal whose noise is below its step reads the quantisation
+/// noise (step/√12 per sample on average), which is what a model can at best reach. [unit]
+pub fn noise_rms(y: &[f64]) -> f64 {
+    if y.len() < 3 {
+        return 0.0;
+    }
+    let mut d2: Vec<f64> = y
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2))
+        .collect();
+    d2.sort_by(f64::total_cmp);
+    let keep = ((1.0 - NOISE_TRIM) * d2.len() as f64).ceil() as usize;
+    let kept = &d2[..keep.clamp(1, d2.len())];
+    let var = kept.iter().sum::<f64>() / kept.len() as f64 / 6.0 / NOISE_TRIM_VARIANCE;
+    var.sqrt()
+}
+
+/// Unwraps an angle logged wrapped (to [0, 2π) or any 2π range) or already unwrapped: each
+/// step is taken as the one of its 2π-equivalents closest to zero, which is right while
+/// the shaft turns less than half a revolution per log interval (3 000 rad/s at 1 kHz).
+pub fn unwrap_angle(wrapped: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(wrapped.len());
+    let mut acc = wrapped.first().copied().unwrap_or(0.0);
+    let mut prev = acc;
+    for &a in wrapped {
+        let d = a - prev;
+        acc += d - 2.0 * PI * (d / (2.0 * PI)).round();
+        prev = a;
+        out.push(acc);
+    }
+    out
+}
+
+/// The shaft angle the logged speed integrates to (trapezoids), from 0. [rad]
+pub fn integrated_angle(t: &[f64], speed: &[f64]) -> Vec<f64> {
+    let mut theta = Vec::with_capacity(t.len());
+    let mut acc = 0.0;
+    for k in 0..t.len().min(speed.len()) {
+        if k > 0 {
+            acc += 0.5 * (speed[k] + speed[k - 1]) * (t[k] - t[k - 1]);
+        }
+        theta.push(acc);
+    }
+    theta
+}
+
+/// Steady-rotation windows: the log cut into chunks of [`STEADY_CHUNK_S`], consecutive
+/// chunks whose mean speeds stay within [`STEADY_SPREAD`] of the window's mean joined until
+/// the window holds at least [`STEADY_WINDOW_S`] and [`STEADY_MIN_REVOLUTIONS`] (at most
+/// [`STEADY_MAX_S`]); a window that cannot reach that is dropped.
+fn steady_windows(t: &[f64], theta: &[f64], period_s: f64) -> Vec<SteadyWindow> {
+    let n = t.len().min(theta.len());
+    let chunk = ((STEADY_CHUNK_S / period_s).round() as usize).max(8);
+    let speed =
+        |r: &Range<usize>| (theta[r.end - 1] - theta[r.start]) / (t[r.end - 1] - t[r.start]);
+    let mut out = Vec::new();
+    let mut open: Option<(usize, Vec<f64>)> = None;
+    let mut start = 0;
+    while start + chunk <= n {
+        let c = start..start + chunk;
+        let w = speed(&c);
+        let joined = match open.take() {
+            Some((s0, mut speeds)) => {
+                let mean = speeds.iter().sum::<f64>() / speeds.len() as f64;
+                if w != 0.0
+                    && (w - mean).abs() <= STEADY_SPREAD * mean.abs()
+                    && w.signum() == mean.signum()
+                {
+                    speeds.push(w);
+                    Some((s0, speeds))
+                } else {
+                    None
+                }
+            }
+            None => None,
+        };
+        let (s0, speeds) = joined.unwrap_or((c.start, vec![w]));
+        let rows = s0..c.end;
+        let turned = (theta[rows.end - 1] - theta[rows.start]).abs() / (2.0 * PI);
+        let length = t[rows.end - 1] - t[rows.start];
+        if w != 0.0 && turned >= STEADY_MIN_REVOLUTIONS && length >= STEADY_WINDOW_S
+            || length >= STEADY_MAX_S
+        {
+            if turned >= STEADY_MIN_REVOLUTIONS && w != 0.0 {
+                out.push(SteadyWindow {
+                    speed_rad_s: speed(&rows),
+                    rows,
+                    revolutions: turned,
+                });
+            }
+        } else {
+            open = Some((s0, speeds));
+        }
+        start += chunk;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unwrapping_restores_a_steady_rotation() {
+        let truth: Vec<f64> = (0..100).map(|k| 1.0 + 0.3 * k as f64).collect();
+        let wrapped: Vec<f64> = truth.iter().map(|a| a.rem_euclid(2.0 * PI)).collect();
+        for (u, a) in unwrap_angle(&wrapped).iter().zip(&truth) {
+            assert!((u - a).abs() < 1e-9, "{u} vs {a}");
+        }
+        let back: Vec<f64> = truth.iter().map(|a| (-a).rem_euclid(2.0 * PI)).collect();
+        let u = unwrap_angle(&back);
+        assert!((u[99] - u[0] + 0.3 * 99.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_speed_integrates_to_the_angle_turned() {
+        // A ramp 0 → 20 rad/s over 1 s turns ½·20·1 = 10 rad (trapezoids are exact on a ramp).
+        let t: Vec<f64> = (0..1001).map(|k| k as f64 * 1e-3).collect();
+        let w: Vec<f64> = t.iter().map(|&t| 20.0 * t).collect();
+        let th = integrated_angle(&t, &w);
+        assert!((th[1000] - 10.0).abs() < 1e-9, "{}", th[1000]);
+    }
+
+    #[test]
+    fn noise_of_white_noise_on_a_ramp_is_its_standard_deviation() {
+        // A deterministic uniform sequence of variance 1/12 on a steep ramp: the second
+        // differences cancel the ramp, the estimate is the deviation within 5 %.
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let y: Vec<f64> = (0..20_000)
+            .map(|k| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                1e3 * k as f64 + u
+            })
+            .collect();
+        let sigma = (1.0f64 / 12.0).sqrt();
+        let est = noise_rms(&y);
+        // Uniform noise has lighter tails than a Gaussian: the trimming removes less and the
+        // correction overshoots a little.
+        assert!((est / sigma - 1.0).abs() < 0.12, "{est} vs {sigma}");
+    }
+
+    #[test]
+    fn steady_windows_are_found_where_the_speed_is_constant() {
+        // 2 s at 0 rad/s, then 6 s at 10 rad/s (1.6 revolutions per second).
+        let t: Vec<f64> = (0..8000).map(|k| k as f64 * 1e-3).collect();
+        let th: Vec<f64> = t
+            .iter()
+            .map(|&t| if t < 2.0 { 0.0 } else { 10.0 * (t - 2.0) })
+            .collect();
+        let w = steady_windows(&t, &th, 1e-3);
+        assert!(!w.is_empty());
+        for s in &w {
+            assert!(t[s.rows.start] >= 2.0, "{:?}", s.rows);
+            assert!((s.speed_rad_s - 10.0).abs() < 0.1, "{}", s.speed_rad_s);
+        }
+    }
+}

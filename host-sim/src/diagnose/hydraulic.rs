@@ -1,0 +1,462 @@
+//! The hydraulic parity relation: the port pressure predicted from the logged shaft angle
+//! (the volume the pump displaced), piston position and low-side pressure, over short
+//! windows each re-started from the measured pressure (multiple shooting), so a small
+//! volume or displacement error cannot integrate into a drift.
+//!
+//! The high-pressure node (port A, its line and chamber A) with the pulsation absorber on
+//! it, eq. 9–11 and 22–26 of the paper as the plant model writes them:
+//!
+//! ```text
+//!   (V_h + A·x)/β · dp/dt = D/2π·s(θ)·ω − G·(p − p_low) − A·dx/dt − q
+//!   I·dq/dt = p − p_gas(v) − R·q,        dv/dt = q        (absorber inlet and gas)
+//!   p_meas = g·p_s + o,                 τ·dp_s/dt = p − p_s   (transducer)
+//! ```
+//!
+//! with V_h the high-side volume at mid-stroke (chamber and line), G the total leakage from
+//! the high side (pump internal and external, cylinder cross-piston: eq. 9–10 with the low
+//! side and case both near the fill pressure), s(θ) the pump's displacement factor (eq. 20,
+//! the plant's [`Pump`]), p_gas the polytropic gas law of the plant's [`GasCharge`] (no
+//! flow into an empty absorber below its precharge).
+//!
+//! Each log interval is cut into substeps of at most [`MAX_SUBSTEP_S`], each solved with
+//! the backward Euler rule linearised about the gas state, closed form: the oil's
+//! compliance against the inlet resistance is a time constant of tens of microseconds,
+//! which an explicit rule could only follow with microsecond steps.
+//!
+//! Window starts (multiple shooting): the transducer's state and the pressure's slope from a
+//! straight line through the window's first [`START_ROWS`] measured rows; the true pressure
+//! the one whose prediction fits the window best in least squares (the window is nearly
+//! linear in it: two runs give the sensitivity); the absorber in equilibrium with it and
+//! filling at the slope.
+
+use crate::diagnose::facts::LogFacts;
+use plant_model::accumulator::{GasCharge, ATMOSPHERE_PA};
+use plant_model::pump::Pump;
+use plant_model::Rig;
+use std::f64::consts::PI;
+use std::ops::Range;
+
+/// Longest integration substep. [s]
+pub const MAX_SUBSTEP_S: f64 = 0.5e-3;
+
+/// Measured rows a window's starting pressure and slope are fitted to.
+pub const START_ROWS: usize = 10;
+
+/// The hydraulic model's parameters (SI).
+#[derive(Clone, Debug)]
+pub struct HydraulicParams {
+    /// Pump displacement D. [m³/rev]
+    pub displacement_m3_per_rev: f64,
+    /// High-side oil volume at mid-stroke, V_h (chamber A and line). [m³]
+    pub high_side_volume_m3: f64,
+    /// Effective bulk modulus β. [Pa]
+    pub bulk_modulus_pa: f64,
+    /// Piston area A. [m²]
+    pub area_m2: f64,
+    /// Absorber gas charge, `None` without an absorber.
+    pub absorber: Option<GasCharge>,
+    /// Absorber inlet inertance I. [kg/m⁴]
+    pub inlet_inertance_kg_m4: f64,
+    /// Absorber inlet resistance R. [Pa·s/m³]
+    pub inlet_resistance_pa_s_m3: f64,
+    /// Total leakage conductance from the high side, G. [(m³/s)/Pa]
+    pub leakage_m3_s_pa: f64,
+    /// Transducer gain g. [1]
+    pub sensor_gain: f64,
+    /// Transducer offset o. [Pa]
+    pub sensor_offset_pa: f64,
+    /// Transducer time constant τ. [s]
+    pub sensor_lag_s: f64,
+    /// Pump pistons z and peak-to-peak flow ripple over mean flow (0: ideal flow).
+    pub ripple: (u32, f64),
+}
+
+impl HydraulicParams {
+    /// The rig file's values.
+    pub fn nominal(rig: &Rig) -> HydraulicParams {
+        let a = &rig.absorber;
+        HydraulicParams {
+            displacement_m3_per_rev: rig.pump.displacement_m3_per_rev,
+            high_side_volume_m3: rig.cylinder.chamber_a_volume_m3,
+            bulk_modulus_pa: rig.oil.bulk_modulus_pa,
+            area_m2: rig.cylinder.area_m2,
+            absorber: a.enabled.then_some(GasCharge {
+                shell_volume_m3: a.shell_volume_m3,
+                precharge_pa: a.precharge_pa,
+                exponent: a.polytropic_exponent,
+            }),
+            inlet_inertance_kg_m4: a.inlet_inertance_kg_m4,
+            inlet_resistance_pa_s_m3: a.inlet_resistance_pa_s_m3,
+            leakage_m3_s_pa: nominal_leakage(rig),
+            sensor_gain: 1.0,
+            sensor_offset_pa: rig.sensors.pressure.offset_pa,
+            sensor_lag_s: rig.sensors.pressure.lag_time_constant_s,
+            ripple: (
+                rig.pump.pistons,
+                if rig.pump.piston_ripple {
+                    if rig.pump.ripple_amplitude_ratio > 0.0 {
+                        rig.pump.ripple_amplitude_ratio
+                    } else {
+                        plant_model::pump::kinematic_ripple_ratio(rig.pump.pistons)
+                    }
+                } else {
+                    0.0
+                },
+            ),
+        }
+    }
+}
+
+/// The rig file's total leakage from the high side of a blocked cylinder: the pump's
+/// internal and external leakage and the cylinder's cross-piston leakage (the low side
+/// and the case both sit near the fill pressure). [(m³/s)/Pa]
+pub fn nominal_leakage(rig: &Rig) -> f64 {
+    rig.pump.internal_leakage_m3_s_pa
+        + rig.pump.external_leakage_m3_s_pa
+        + rig.pump.extra_leakage_m3_s_pa
+        + rig.cylinder.internal_leakage_m3_s_pa
+}
+
+/// The logged signals the hydraulic model reads.
+#[derive(Clone, Copy, Debug)]
+pub struct HydraulicInputs<'a> {
+    /// Time. [s]
+    pub t_s: &'a [f64],
+    /// Shaft angle, unwrapped. [rad]
+    pub theta_rad: &'a [f64],
+    /// Low-side pressure. [Pa]
+    pub p_low_pa: &'a [f64],
+    /// Piston position, when it moves. [m]
+    pub x_m: Option<&'a [f64]>,
+    /// Measured pressure (window starts). [Pa]
+    pub p_pa: &'a [f64],
+}
+
+impl<'a> HydraulicInputs<'a> {
+    /// The inputs of `log` with its `facts`.
+    pub fn of(log: &'a crate::bench_log::BenchLog, facts: &'a LogFacts) -> HydraulicInputs<'a> {
+        HydraulicInputs {
+            t_s: &log.t_s,
+            theta_rad: &facts.theta_rad,
+            p_low_pa: &facts.p_low_pa,
+            x_m: log.x_m.as_deref().filter(|_| facts.piston_moves),
+            p_pa: &log.p_pa,
+        }
+    }
+}
+
+/// State of the high-pressure node.
+#[derive(Clone, Copy, Debug)]
+struct State {
+    /// Port pressure. [Pa]
+    p: f64,
+    /// Absorber inlet flow. [m³/s]
+    q: f64,
+    /// Oil in the absorber. [m³]
+    v: f64,
+    /// Absolute gas pressure in the absorber, integrated in the gas law's rate form
+    /// dp_g = n·p_g·dv/V_g (the plant's [`GasCharge::pressure_rate`]; no power per step). [Pa]
+    g: f64,
+    /// Transducer state. [Pa]
+    s: f64,
+}
+
+/// Intercept at the first row and slope of a straight line through `y` against `t`.
+fn line_start(t: &[f64], y: &[f64]) -> (f64, f64) {
+    let n = t.len().min(y.len());
+    if n < 2 {
+        return (y.first().copied().unwrap_or(0.0), 0.0);
+    }
+    let t0 = t[0];
+    let (mut st, mut sy, mut stt, mut sty) = (0.0, 0.0, 0.0, 0.0);
+    for k in 0..n {
+        let x = t[k] - t0;
+        st += x;
+        sy += y[k];
+        stt += x * x;
+        sty += x * y[k];
+    }
+    let nf = n as f64;
+    let den = nf * stt - st * st;
+    if den <= 0.0 {
+        return (sy / nf, 0.0);
+    }
+    let slope = (nf * sty - st * sy) / den;
+    ((sy - slope * st) / nf, slope)
+}
+
+/// A prepared model: the parameters with the pump's ripple tables built once.
+pub struct Hydraulics {
+    params: HydraulicParams,
+    pump: Pump,
+}
+
+impl Hydraulics {
+    /// Prepares `params` on `rig` (for the pump's geometry).
+    pub fn new(params: HydraulicParams, rig: &Rig) -> Hydraulics {
+        let mut pp = rig.pump.clone();
+        pp.pistons = params.ripple.0.max(1);
+        pp.piston_ripple = params.ripple.1 > 0.0;
+        pp.ripple_amplitude_ratio = params.ripple.1;
+        Hydraulics {
+            pump: Pump::new(&pp),
+            params,
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &HydraulicParams {
+        &self.params
+    }
+
+    /// Predicts the measured pressure over each of `windows`, written into `out` at the
+    /// windows' rows (the other rows untouched).
+    pub fn predict(&self, inputs: &HydraulicInputs<'_>, windows: &[Range<usize>], out: &mut [f64]) {
+        for w in windows {
+            self.predict_window(inputs, w.clone(), out);
+        }
+    }
+
+    fn predict_window(&self, x: &HydraulicInputs<'_>, rows: Range<usize>, out: &mut [f64]) {
+        let hp = &self.params;
+        let head = rows.start..(rows.start + START_ROWS).min(rows.end);
+        let (s0, slope) = line_start(&x.t_s[head.clone()], &x.p_pa[head]);
+        let gain = hp.sensor_gain.max(1e-6);
+        let s_true = (s0 - hp.sensor_offset_pa) / gain;
+        let guess = s_true + hp.sensor_lag_s * slope / gain;
+        // Multiple shooting: the window's initial pressure is the least-squares one, found
+        // from the response to a small change of it (the window is nearly linear in it).
+        let n = rows.len();
+        let mut a = vec![0.0; n];
+        let mut b = vec![0.0; n];
+        self.simulate_window(x, rows.clone(), guess, s_true, slope / gain, &mut a);
+        let delta = 1e3;
+        self.simulate_window(x, rows.clone(), guess + delta, s_true, slope / gain, &mut b);
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 1..n {
+            let g = (b[i] - a[i]) / delta;
+            num += g * (x.p_pa[rows.start + i] - a[i]);
+            den += g * g;
+        }
+        let shift = if den > 0.0 { num / den } else { 0.0 };
+        for i in 0..n {
+            out[rows.start + i] = a[i] + shift * (b[i] - a[i]) / delta;
+        }
+    }
+
+    /// The measured pressure over `rows` from true pressure `p0` and transducer state
+    /// `s0` at the first row, the pressure rising at `slope` there, into `out` (row i of
+    /// the window at index i).
+    fn simulate_window(
+        &self,
+        x: &HydraulicInputs<'_>,
+        rows: Range<usize>,
+        p0: f64,
+        s0: f64,
+        slope: f64,
+        out: &mut [f64],
+    ) {
+        let hp = &self.params;
+        let (v0, q0) = match &hp.absorber {
+            Some(g) => (g.oil_volume_m3(p0), g.capacitance_m3_per_pa(p0) * slope),
+            None => (0.0, 0.0),
+        };
+        let g0 = match &hp.absorber {
+            Some(g) if v0 > 0.0 => g.pressure_pa(v0) + ATMOSPHERE_PA,
+            Some(g) => g.precharge_abs_pa(),
+            None => ATMOSPHERE_PA,
+        };
+        let mut st = State {
+            p: p0,
+            q: q0,
+            v: v0,
+            g: g0,
+            s: s0,
+        };
+        let ripple = hp.ripple.1 > 0.0;
+        let gain = hp.sensor_gain;
+        out[0] = gain * st.s + hp.sensor_offset_pa;
+        let per_rad = hp.displacement_m3_per_rev / (2.0 * PI);
+        for k in rows.start..rows.end - 1 {
+            let dt = x.t_s[k + 1] - x.t_s[k];
+            let steps = ((dt / MAX_SUBSTEP_S).ceil() as usize).max(1);
+            let h = dt / steps as f64;
+            let dtheta = x.theta_rad[k + 1] - x.theta_rad[k];
+            let (x0, dx) = match x.x_m {
+                Some(xm) => (xm[k], xm[k + 1] - xm[k]),
+                None => (0.0, 0.0),
+            };
+            let p_low = x.p_low_pa[k];
+            for j in 0..steps {
+                let f = (j as f64 + 0.5) / steps as f64;
+                let factor = if ripple {
+                    self.pump.displacement_factor(x.theta_rad[k] + f * dtheta)
+                } else {
+                    1.0
+                };
+                // Flow into the node over the substep: pump minus piston, as a mean. [m³/s]
+                let q_in = (per_rad * factor * dtheta - hp.area_m2 * dx) / dt;
+                let volume = hp.high_side_volume_m3 + hp.area_m2 * (x0 + f * dx);
+                let c_oil = volume.max(1e-9) / hp.bulk_modulus_pa;
+                self.substep(&mut st, h, q_in, p_low, c_oil);
+            }
+            out[k + 1 - rows.start] = gain * st.s + hp.sensor_offset_pa;
+        }
+    }
+
+    /// One backward-Euler substep of length `h` with inflow `q_in`, see the module docs.
+    #[inline]
+    fn substep(&self, st: &mut State, h: f64, q_in: f64, p_low: f64, c_oil: f64) {
+        let hp = &self.params;
+        let g = hp.leakage_m3_s_pa;
+        let rhs = c_oil * st.p + h * q_in + h * g * p_low;
+        let diag = c_oil + h * g;
+        let mut p_new = rhs / diag;
+        if let Some(gas) = &hp.absorber {
+            let p_gas = st.g - ATMOSPHERE_PA;
+            let gas_vol = (gas.shell_volume_m3 - st.v).max(1e-3 * gas.shell_volume_m3);
+            let k_g = gas.exponent * st.g / gas_vol;
+            let den = hp.inlet_inertance_kg_m4 + h * hp.inlet_resistance_pa_s_m3 + h * h * k_g;
+            // q' = a + b·p'.
+            let a = (hp.inlet_inertance_kg_m4 * st.q - h * p_gas) / den;
+            let b = h / den;
+            let p_try = (rhs - h * a) / (diag + h * b);
+            let q_try = a + b * p_try;
+            // The poppet closes an empty absorber: no oil leaves it.
+            if st.v <= 0.0 && q_try < 0.0 {
+                st.q = 0.0;
+                st.v = 0.0;
+                st.g = gas.precharge_abs_pa();
+            } else {
+                p_new = p_try;
+                st.q = q_try;
+                let v_new = (st.v + h * q_try).max(0.0);
+                st.g = if v_new > 0.0 {
+                    st.g + k_g * (v_new - st.v)
+                } else {
+                    gas.precharge_abs_pa()
+                };
+                st.v = v_new;
+            }
+        }
+        st.p = p_new;
+        st.s = if hp.sensor_lag_s > 0.0 {
+            st.s + (st.p - st.s) * (1.0 - (-h / hp.sensor_lag_s).exp())
+        } else {
+            st.p
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The model run open-loop from pressure `p0` (transducer settled there, no slope).
+    fn open_loop(hp: &HydraulicParams, t: &[f64], th: &[f64], p_low: f64, p0: f64) -> Vec<f64> {
+        let n = t.len();
+        let pl = vec![p_low; n];
+        let p = vec![p0; n];
+        let inputs = HydraulicInputs {
+            t_s: t,
+            theta_rad: th,
+            p_low_pa: &pl,
+            x_m: None,
+            p_pa: &p,
+        };
+        let mut out = vec![0.0; n];
+        Hydraulics::new(hp.clone(), &Rig::nominal()).simulate_window(
+            &inputs,
+            0..n,
+            p0,
+            p0,
+            0.0,
+            &mut out,
+        );
+        out
+    }
+
+    #[test]
+    fn oil_alone_is_compressed_by_the_displaced_volume_over_its_capacitance() {
+        // No absorber, no leakage: Δp = D/2π·Δθ·β/V, exactly (the capacitance is constant).
+        let rig = Rig::nominal();
+        let mut hp = HydraulicParams::nominal(&rig);
+        hp.absorber = None;
+        hp.leakage_m3_s_pa = 0.0;
+        let n = 500;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let th: Vec<f64> = t.iter().map(|t| 20.0 * t).collect();
+        let out = open_loop(&hp, &t, &th, 0.5e6, 1e6);
+        let dv = 1.5e-6 / (2.0 * PI) * th[n - 1];
+        let expected = 1e6 + dv * 6.5e8 / 450e-6;
+        assert!(
+            (out[n - 1] - expected).abs() < 1e-6 * expected,
+            "{} vs {expected}",
+            out[n - 1]
+        );
+    }
+
+    #[test]
+    fn a_hold_with_the_pump_replacing_the_leakage_stays_put() {
+        // The pump turns at ω = 2π·G·(p − p_low)/D: the pressure holds at any absorber state.
+        let rig = Rig::nominal();
+        let hp = HydraulicParams::nominal(&rig);
+        let (p0, pl) = (5e6, 0.5e6);
+        let w = 2.0 * PI * hp.leakage_m3_s_pa * (p0 - pl) / hp.displacement_m3_per_rev;
+        let n = 2000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let th: Vec<f64> = t.iter().map(|t| w * t).collect();
+        let out = open_loop(&hp, &t, &th, pl, p0);
+        for y in &out {
+            assert!((y - p0).abs() < 10.0, "{y}");
+        }
+    }
+
+    #[test]
+    fn above_precharge_the_absorber_adds_the_gas_law_capacitance() {
+        // Quasi-static filling from 4 to ~4.2 MPa: the volume displaced equals the oil
+        // compressed plus the absorber's gas-law volume change (eq. 22), to 1 %.
+        let rig = Rig::nominal();
+        let mut hp = HydraulicParams::nominal(&rig);
+        hp.leakage_m3_s_pa = 0.0;
+        let gas = hp.absorber.unwrap();
+        let n = 3000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        // 2 mL over 3 s.
+        let per_rad = 1.5e-6 / (2.0 * PI);
+        let w = 2e-6 / 3.0 / per_rad;
+        let th: Vec<f64> = t.iter().map(|t| w * t).collect();
+        let out = open_loop(&hp, &t, &th, 0.5e6, 4e6);
+        let p1 = out[n - 1];
+        let stored = (p1 - 4e6) * hp.high_side_volume_m3 / hp.bulk_modulus_pa
+            + gas.oil_volume_m3(p1)
+            - gas.oil_volume_m3(4e6);
+        let displaced = per_rad * th[n - 1];
+        assert!(
+            (stored / displaced - 1.0).abs() < 0.01,
+            "{stored} vs {displaced}"
+        );
+    }
+
+    #[test]
+    fn the_transducer_lags_a_ramp_by_its_time_constant() {
+        // A pressure ramp of rate r seen through a first-order lag τ trails by r·τ.
+        let rig = Rig::nominal();
+        let mut hp = HydraulicParams::nominal(&rig);
+        hp.absorber = None;
+        hp.leakage_m3_s_pa = 0.0;
+        let n = 400;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let th: Vec<f64> = t.iter().map(|t| 2.0 * t).collect();
+        let ideal = open_loop(&hp, &t, &th, 0.5e6, 1e6);
+        hp.sensor_lag_s = 0.01;
+        let lagged = open_loop(&hp, &t, &th, 0.5e6, 1e6);
+        let rate = 1.5e-6 / (2.0 * PI) * 2.0 * 6.5e8 / 450e-6;
+        let trail = ideal[n - 1] - lagged[n - 1];
+        assert!(
+            (trail / (rate * 0.01) - 1.0).abs() < 0.02,
+            "{trail} vs {}",
+            rate * 0.01
+        );
+    }
+}

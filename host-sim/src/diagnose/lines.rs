@@ -1,0 +1,244 @@
+//! Angle-locked lines: least squares on sin/cos of k·θ (lock-in) over each steady-rotation
+//! window, for the orders the catalogue's periodic effects live at and their neighbours,
+//! whose lines measure the noise floor a line must stand above.
+//!
+//! Per window and order k the signals' complex amplitudes Z (y ≈ Re(Z·e^{jkθ})) give the
+//! torque line the shaft balance leaves unexplained (eq. 4 at one order, the speed steady):
+//!
+//! ```text
+//!   T_k = K_t·I_q,k + J·(k·ω̄)²·Θ_k − D/2π·P_k
+//! ```
+//!
+//! with I_q,k, Θ_k, P_k the lines of the q current, the detrended angle and the pressure:
+//! the angle's line is the shaft's oscillation, J·(kω̄)² turns it into the torque that
+//! accelerated it, and the pump's torque follows the pressure's line. A torque effect
+//! (cogging, flux harmonics, the pump's torque ripple, the torque a current-sensor offset
+//! hides) leaves T_k; a voltage disturbance (dead time) moves current and angle together
+//! and leaves T_k near zero while the d current shows its line.
+
+use crate::bench_log::BenchLog;
+use crate::diagnose::facts::{LogFacts, SteadyWindow};
+use nalgebra::{DMatrix, DVector};
+use rustfft::num_complex::Complex64;
+
+/// Neighbouring orders on each side of a line whose amplitudes measure its noise floor.
+pub const NEIGHBOURS: u32 = 4;
+
+/// The lines of one steady window.
+#[derive(Clone, Debug)]
+pub struct WindowLines {
+    /// The window.
+    pub window: SteadyWindow,
+    /// Mean q current. [A]
+    pub iq_mean_a: f64,
+    /// Mean pressure difference across the pump. [Pa]
+    pub dp_mean_pa: f64,
+    /// Per analysed order: the lines.
+    pub orders: Vec<OrderLines>,
+}
+
+/// The lines at one order in one window.
+#[derive(Clone, Copy, Debug)]
+pub struct OrderLines {
+    /// Cycles per revolution.
+    pub order: u32,
+    /// q current. [A]
+    pub iq: Complex64,
+    /// d current. [A]
+    pub id: Complex64,
+    /// Detrended angle. [rad]
+    pub theta: Complex64,
+    /// Pressure. [Pa]
+    pub p: Complex64,
+    /// Unexplained torque T_k. [N·m]
+    pub torque: Complex64,
+}
+
+impl WindowLines {
+    /// The lines at `order`, if analysed.
+    pub fn at(&self, order: u32) -> Option<&OrderLines> {
+        self.orders.iter().find(|o| o.order == order)
+    }
+
+    /// Noise variance per real component of a line of `value` at `order` (mean of |Z|²/2
+    /// over the neighbouring orders that are not themselves candidates). [unit²]
+    pub fn floor(
+        &self,
+        order: u32,
+        candidates: &[u32],
+        value: impl Fn(&OrderLines) -> Complex64,
+    ) -> f64 {
+        let mut sum = 0.0;
+        let mut n = 0usize;
+        for d in 1..=NEIGHBOURS {
+            for k in [order.saturating_sub(d), order + d] {
+                if k == 0 || candidates.contains(&k) {
+                    continue;
+                }
+                if let Some(o) = self.at(k) {
+                    sum += value(o).norm_sqr() / 2.0;
+                    n += 1;
+                }
+            }
+        }
+        if n == 0 {
+            f64::INFINITY
+        } else {
+            (sum / n as f64).max(f64::MIN_POSITIVE)
+        }
+    }
+}
+
+/// The orders to analyse: each candidate and its neighbours, without order 0 and above the
+/// window's Nyquist order.
+fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
+    let mut v: Vec<u32> = candidates
+        .iter()
+        .flat_map(|&k| k.saturating_sub(NEIGHBOURS)..=k + NEIGHBOURS)
+        .filter(|k| *k > 0 && *k <= max_order)
+        .collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// Complex amplitudes of `signals` at `orders` over `rows`, by one least-squares fit of a
+/// mean, a slope and sin/cos of k·θ for every order (the orders are near-orthogonal over
+/// whole revolutions; fitting them together removes what leaks between them).
+fn lock_in(
+    t: &[f64],
+    theta: &[f64],
+    rows: std::ops::Range<usize>,
+    orders: &[u32],
+    signals: &[&[f64]],
+) -> Option<Vec<Vec<Complex64>>> {
+    let n = rows.len();
+    let cols = 2 + 2 * orders.len();
+    if n < 2 * cols {
+        return None;
+    }
+    let t0 = t[rows.start];
+    let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
+    let a = DMatrix::from_fn(n, cols, |i, j| {
+        let k = rows.start + i;
+        match j {
+            0 => 1.0,
+            1 => (t[k] - t0) / span - 0.5,
+            _ => {
+                let order = orders[(j - 2) / 2] as f64;
+                let x = order * theta[k];
+                if (j - 2) % 2 == 0 {
+                    x.cos()
+                } else {
+                    x.sin()
+                }
+            }
+        }
+    });
+    let svd = a.svd(true, true);
+    signals
+        .iter()
+        .map(|y| {
+            let b = DVector::from_iterator(n, y[rows.clone()].iter().copied());
+            let x = svd.solve(&b, 1e-12).ok()?;
+            Some(
+                (0..orders.len())
+                    .map(|m| Complex64::new(x[2 + 2 * m], -x[3 + 2 * m]))
+                    .collect(),
+            )
+        })
+        .collect()
+}
+
+/// The lines of every steady window at `candidates` (and their neighbours), with the
+/// shaft's torque constant, inertia and displacement `kt`, `j`, `d_per_rad` (D/2π).
+pub fn window_lines(
+    log: &BenchLog,
+    facts: &LogFacts,
+    candidates: &[u32],
+    kt: f64,
+    j: f64,
+    d_per_rad: f64,
+) -> Vec<WindowLines> {
+    let t = &log.t_s;
+    let theta = &facts.theta_rad;
+    facts
+        .steady
+        .iter()
+        .filter_map(|w| {
+            let rows = w.rows.clone();
+            // Highest order whose line stays below a third of the sampling rate.
+            let w_abs = w.speed_rad_s.abs().max(1e-9);
+            let max_order = ((2.0 * std::f64::consts::PI / facts.period_s) / 3.0 / w_abs) as u32;
+            let orders = analysed_orders(candidates, max_order);
+            if orders.is_empty() {
+                return None;
+            }
+            let trend: Vec<f64> = {
+                // The angle less its straight line: the shaft's oscillation about the mean
+                // rotation.
+                let (a, b) = (theta[rows.start], theta[rows.end - 1]);
+                let (ta, tb) = (t[rows.start], t[rows.end - 1]);
+                let mut v = vec![0.0; facts.rows];
+                for k in rows.clone() {
+                    v[k] = theta[k] - (a + (b - a) * (t[k] - ta) / (tb - ta));
+                }
+                v
+            };
+            let z = lock_in(
+                t,
+                theta,
+                rows.clone(),
+                &orders,
+                &[&log.iq_a, &log.id_a, &trend, &log.p_pa],
+            )?;
+            let lines = orders
+                .iter()
+                .enumerate()
+                .map(|(m, &order)| {
+                    let (iq, id, th, p) = (z[0][m], z[1][m], z[2][m], z[3][m]);
+                    let wk = order as f64 * w_abs;
+                    OrderLines {
+                        order,
+                        iq,
+                        id,
+                        theta: th,
+                        p,
+                        torque: iq * kt + th * (j * wk * wk) - p * d_per_rad,
+                    }
+                })
+                .collect();
+            let mean = |y: &[f64]| y[rows.clone()].iter().sum::<f64>() / rows.len() as f64;
+            Some(WindowLines {
+                window: w.clone(),
+                iq_mean_a: mean(&log.iq_a),
+                dp_mean_pa: mean(&log.p_pa) - mean(&facts.p_low_pa),
+                orders: lines,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn lock_in_reads_amplitude_and_phase_of_a_line() {
+        // y = 0.3·cos(18θ − 0.7) + a slope, θ turning at 7 rad/s: Z = 0.3·e^{−j0.7}.
+        let n = 4000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let th: Vec<f64> = t.iter().map(|t| 7.0 * t).collect();
+        let y: Vec<f64> = th
+            .iter()
+            .zip(&t)
+            .map(|(a, t)| 0.3 * (18.0 * a - 0.7).cos() + 2.0 * t)
+            .collect();
+        let z = lock_in(&t, &th, 0..n, &[17, 18, 19], &[&y]).unwrap();
+        let want = Complex64::from_polar(0.3, -0.7);
+        assert!((z[0][1] - want).norm() < 1e-9, "{:?}", z[0][1]);
+        assert!(z[0][0].norm() < 1e-9 && z[0][2].norm() < 1e-9);
+        let _ = PI;
+    }
+}

@@ -1,0 +1,325 @@
+//! The mechanical parity relation: the shaft's torque balance (eq. 3–4, 16–21) read both
+//! ways from the logged signals.
+//!
+//! ```text
+//!   T_e(i_d, i_q, θ) + T_cog(θ) = J·dω/dt + D/2π·s(θ)·(p − p_low) + B·ω + T_c·sgn(ω) + U(θ)
+//! ```
+//!
+//! with T_e the plant motor's torque (eq. 3 with its flux harmonics, eq. 17–19), T_cog its
+//! cogging (eq. 16), s(θ) the plant pump's displacement factor (eq. 20) and U the
+//! unexplained torque lines the angle-locked effects were fitted as ([`TorqueLine`]).
+//!
+//! - The q current the model needs ([`Mechanics::needed_current`]): solved for i_q with the
+//!   logged speed's derivative, pressure and angle; compared with the logged `iq_a`, a
+//!   torque the model lacks shows directly as current. A current-sensor offset is the
+//!   difference between the measured current and the one that flowed, so it shows here too.
+//! - The speed ([`Mechanics::speed`]): the balance integrated from the logged currents over
+//!   short windows re-started from the logged speed (multiple shooting), so a torque error
+//!   shows as a slope within each window and never as a drift.
+//!
+//! The speed's derivative is the central difference over ±[`RATE_HALF_WIDTH`] rows of the
+//! speed the logged angle gives (or of the logged speed): one encoder count over one log
+//! interval is a speed step far larger than the current's noise.
+
+use crate::bench_log::BenchLog;
+use crate::diagnose::facts::LogFacts;
+use plant_model::motor::Motor;
+use plant_model::pump::Pump;
+use plant_model::rig::{MotorParams, PumpParams};
+use plant_model::Rig;
+use rustfft::num_complex::Complex64;
+use std::f64::consts::PI;
+use std::ops::Range;
+
+/// Rows on each side of the central differences that give speed and acceleration.
+pub const RATE_HALF_WIDTH: usize = 5;
+
+/// Speed over which the Coulomb torque's sign fades in (a smooth sgn). [rad/s]
+pub const COULOMB_FADE_RAD_S: f64 = 0.5;
+
+/// What an angle-locked line's amplitude multiplies, row by row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LineScale {
+    /// Nothing: a torque in N·m (cogging, a current offset's image through K_t).
+    Constant,
+    /// The electromagnetic torque K_t·i_q (flux harmonics, eq. 19).
+    Electromagnetic,
+    /// The pump's pressure difference times this factor (its torque ripple, eq. 20). [m³/rad]
+    PressureDifference(f64),
+}
+
+/// A line of unexplained torque U = Re(Z·x·e^{jkθ}): the logged current's torque less the
+/// torque the shaft's motion and load account for. A torque the model lacks is −U on the
+/// shaft; a current-sensor offset's image is U/K_t in the measured current.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TorqueLine {
+    /// Cycles per mechanical revolution. [1]
+    pub order: u32,
+    /// Complex amplitude per unit of the scale. [N·m or 1]
+    pub amplitude: Complex64,
+    /// What scales it.
+    pub scale: LineScale,
+}
+
+/// The mechanical model's parameters (SI).
+#[derive(Clone, Debug)]
+pub struct MechanicalParams {
+    /// The motor: ψ_f, L_d, L_q, the rig's cogging and flux harmonics (eq. 3, 16–19).
+    pub motor: MotorParams,
+    /// Shaft inertia J (motor and pump). [kg·m²]
+    pub inertia_kg_m2: f64,
+    /// Viscous friction B. [N·m·s]
+    pub viscous_nm_s: f64,
+    /// Coulomb friction T_c. [N·m]
+    pub coulomb_nm: f64,
+    /// The pump (displacement and ripple, eq. 20).
+    pub pump: PumpParams,
+    /// Unexplained torque lines (the angle-locked effects fitted).
+    pub lines: Vec<TorqueLine>,
+}
+
+impl MechanicalParams {
+    /// The rig file's values.
+    pub fn nominal(rig: &Rig) -> MechanicalParams {
+        MechanicalParams {
+            motor: rig.motor.clone(),
+            inertia_kg_m2: rig.shaft.inertia_kg_m2(),
+            viscous_nm_s: rig.shaft.viscous_nm_s,
+            coulomb_nm: rig.shaft.coulomb_nm,
+            pump: rig.pump.clone(),
+            lines: Vec::new(),
+        }
+    }
+}
+
+/// Speed and acceleration from the angle (or the logged speed), computed once per log.
+#[derive(Clone, Debug)]
+pub struct ShaftMotion {
+    /// Speed. [rad/s]
+    pub speed_rad_s: Vec<f64>,
+    /// Acceleration. [rad/s²]
+    pub accel_rad_s2: Vec<f64>,
+}
+
+/// Central difference of `y` against `t` over ±`h` rows, clipped at the ends.
+pub fn central_rate(t: &[f64], y: &[f64], h: usize) -> Vec<f64> {
+    let n = t.len().min(y.len());
+    (0..n)
+        .map(|k| {
+            let lo = k.saturating_sub(h);
+            let hi = (k + h).min(n - 1);
+            if hi > lo {
+                (y[hi] - y[lo]) / (t[hi] - t[lo])
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+impl ShaftMotion {
+    /// The shaft's motion in `log`.
+    pub fn of(log: &BenchLog, facts: &LogFacts) -> ShaftMotion {
+        let speed = if facts.angle_logged {
+            central_rate(&log.t_s, &facts.theta_rad, RATE_HALF_WIDTH)
+        } else {
+            log.speed_rad_s.clone()
+        };
+        let accel = central_rate(&log.t_s, &speed, RATE_HALF_WIDTH);
+        ShaftMotion {
+            speed_rad_s: speed,
+            accel_rad_s2: accel,
+        }
+    }
+}
+
+/// A prepared mechanical model.
+pub struct Mechanics {
+    params: MechanicalParams,
+    motor: Motor,
+    pump: Pump,
+}
+
+impl Mechanics {
+    /// Prepares `params`.
+    pub fn new(params: MechanicalParams) -> Mechanics {
+        Mechanics {
+            motor: Motor::new(&params.motor),
+            pump: Pump::new(&params.pump),
+            params,
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &MechanicalParams {
+        &self.params
+    }
+
+    /// Electromagnetic torque at row `k` as (∂T/∂i_q, the rest) with the logged i_d, so the
+    /// torque is slope·i_q + rest (eq. 3 with the flux harmonics, plus cogging). [N·m/A, N·m]
+    #[inline]
+    fn torque_terms(&self, log: &BenchLog, facts: &LogFacts, k: usize) -> (f64, f64) {
+        let theta = facts.theta_rad[k];
+        let flux = self
+            .motor
+            .magnet_flux(self.params.motor.pole_pairs as f64 * theta);
+        let id = log.id_a[k];
+        let rest = self.motor.torque_nm(id, 0.0, &flux);
+        let slope = self.motor.torque_nm(id, 1.0, &flux) - rest;
+        (slope, rest + self.motor.cogging_torque_nm(theta))
+    }
+
+    /// Load torque at row `k` from the logged pressures and angle, the shaft at `speed`:
+    /// pump, viscous and Coulomb friction. [N·m]
+    #[inline]
+    fn load_torque(&self, log: &BenchLog, facts: &LogFacts, k: usize, speed: f64) -> f64 {
+        let m = &self.params;
+        let factor = if m.pump.piston_ripple {
+            self.pump.displacement_factor(facts.theta_rad[k])
+        } else {
+            1.0
+        };
+        self.pump
+            .load_torque(log.p_pa[k], facts.p_low_pa[k], factor)
+            + m.viscous_nm_s * speed
+            + m.coulomb_nm * (speed / COULOMB_FADE_RAD_S).tanh()
+    }
+
+    /// The unexplained torque lines at row `k` (electromagnetic torque `t_em`). [N·m]
+    #[inline]
+    fn line_torque(&self, log: &BenchLog, facts: &LogFacts, k: usize, t_em: f64) -> f64 {
+        let theta = facts.theta_rad[k];
+        self.params
+            .lines
+            .iter()
+            .map(|l| {
+                let x = match l.scale {
+                    LineScale::Constant => 1.0,
+                    LineScale::Electromagnetic => t_em,
+                    LineScale::PressureDifference(f) => f * (log.p_pa[k] - facts.p_low_pa[k]),
+                };
+                x * (l.amplitude * Complex64::from_polar(1.0, l.order as f64 * theta)).re
+            })
+            .sum()
+    }
+
+    /// The q current the model needs at every row in `rows`, written into `out`. [A]
+    pub fn needed_current(
+        &self,
+        log: &BenchLog,
+        facts: &LogFacts,
+        motion: &ShaftMotion,
+        rows: Range<usize>,
+        out: &mut [f64],
+    ) {
+        let j = self.params.inertia_kg_m2;
+        for k in rows {
+            let w = motion.speed_rad_s[k];
+            let need = self.load_torque(log, facts, k, w) + j * motion.accel_rad_s2[k];
+            let (slope, rest) = self.torque_terms(log, facts, k);
+            let slope = if slope.abs() > 1e-9 { slope } else { 1e-9 };
+            let t_em = slope * log.iq_a[k] + rest;
+            out[k] = (need - rest + self.line_torque(log, facts, k, t_em)) / slope;
+        }
+    }
+
+    /// The speed over each of `windows`, integrated from the logged currents and re-started
+    /// from the shaft's speed at each window's first row, written into `out`. [rad/s]
+    pub fn speed(
+        &self,
+        log: &BenchLog,
+        facts: &LogFacts,
+        motion: &ShaftMotion,
+        windows: &[Range<usize>],
+        out: &mut [f64],
+    ) {
+        let t = &log.t_s;
+        let j = self.params.inertia_kg_m2.max(1e-12);
+        for win in windows {
+            let mut w = motion.speed_rad_s[win.start];
+            out[win.start] = w;
+            for k in win.start..win.end - 1 {
+                let (slope, rest) = self.torque_terms(log, facts, k);
+                let t_em = slope * log.iq_a[k] + rest;
+                let drive = t_em
+                    - self.line_torque(log, facts, k, t_em)
+                    - self.load_torque(log, facts, k, w);
+                w += (t[k + 1] - t[k]) * drive / j;
+                out[k + 1] = w;
+            }
+        }
+    }
+}
+
+/// Mean over a revolution of the pump's torque ripple at its fundamental order per unit
+/// peak-to-peak ratio: the amplitude of (s(θ) − 1)'s line at 2z (odd z) or z for a ripple
+/// of peak-to-peak 1. [1]
+pub fn ripple_fundamental_per_ratio(rig: &Rig, pistons: u32) -> f64 {
+    let mut pp = rig.pump.clone();
+    pp.pistons = pistons.max(1);
+    pp.piston_ripple = true;
+    pp.ripple_amplitude_ratio = 1.0;
+    let pump = Pump::new(&pp);
+    let order = plant_model::pump::ripple_order(pistons.max(1)) as f64;
+    let n = 4096;
+    let (mut c, mut s) = (0.0, 0.0);
+    for j in 0..n {
+        let th = 2.0 * PI * j as f64 / n as f64;
+        let y = pump.displacement_factor(th) - 1.0;
+        c += y * (order * th).cos();
+        s += y * (order * th).sin();
+    }
+    2.0 * (c * c + s * s).sqrt() / n as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_kinematic_ripples_fundamental_is_that_of_a_periodic_parabola() {
+        // For odd z the shape is a cosine cap over π/z, nearly a parabola between cusps: a
+        // periodic parabola's fundamental is 4/π² ≈ 0.405 of its peak-to-peak.
+        let r = ripple_fundamental_per_ratio(&Rig::nominal(), 9);
+        assert!((r - 4.0 / (PI * PI)).abs() < 0.01, "{r}");
+    }
+
+    #[test]
+    fn a_steady_hold_needs_the_pumps_torque_over_the_torque_constant() {
+        // 5 MPa across the pump at a constant 5 rad/s: i_q = (D/2π·Δp + B·ω)/K_t.
+        let rig = Rig::nominal();
+        let n = 200;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let mut log = crate::bench_log::BenchLog {
+            metadata: Vec::new(),
+            t_s: t.clone(),
+            p_ref_pa: vec![5.5e6; n],
+            p_pa: vec![5.5e6; n],
+            speed_rad_s: vec![5.0; n],
+            iq_a: vec![1.0; n],
+            id_a: vec![0.0; n],
+            theta_m_rad: Some(t.iter().map(|t| 5.0 * t).collect()),
+            x_m: None,
+            p_low_pa: Some(vec![0.5e6; n]),
+            speed_ref_rad_s: None,
+            iq_ref_a: None,
+            ud_v: None,
+            uq_v: None,
+            udc_v: None,
+            oil_temp_c: None,
+        };
+        log.metadata.clear();
+        let facts = LogFacts::of(&log, &rig);
+        let motion = ShaftMotion::of(&log, &facts);
+        let mech = Mechanics::new(MechanicalParams::nominal(&rig));
+        let mut out = vec![0.0; n];
+        mech.needed_current(&log, &facts, &motion, 0..n, &mut out);
+        let kt = 1.5 * 4.0 * 0.1827;
+        let expected = (1.5e-6 / (2.0 * PI) * 5e6 + 3.035e-4 * 5.0) / kt;
+        assert!(
+            (out[100] - expected).abs() < 1e-9,
+            "{} vs {expected}",
+            out[100]
+        );
+    }
+}
