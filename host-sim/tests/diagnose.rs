@@ -106,7 +106,7 @@ fn a_nominal_rig_is_explained_by_the_nominal_model() {
 
 #[test]
 fn an_inverter_dead_time_is_named_and_measured() {
-    // 1.5 µs: a voltage error of 2·t_d·f_pwm·U_dc = 16.8 V per leg at full current.
+    // 1.5 µs: a voltage error of t_d·f_pwm·U_dc = 8.4 V per leg at full current.
     let (v, report) = diagnose(
         "dead-time",
         "pressure-hold",

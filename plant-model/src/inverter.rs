@@ -4,7 +4,11 @@
 //! Each leg's average pole voltage is d_x·U_dc. During the dead time both switches of a leg
 //! are off and the phase current free-wheels through a diode: a positive (motor-bound)
 //! current through the lower diode, a negative one through the upper. Each PWM period has
-//! two such intervals, so the average pole voltage loses t_d·f_pwm·U_dc·sign(i_x). The
+//! two such intervals, but only one of them departs from the command: for a positive
+//! current the rising edge comes t_d late (the lower diode holds the pole low) while the
+//! falling edge does not (the diode takes over exactly when the upper switch opens). The
+//! average pole voltage therefore loses t_d·f_pwm·U_dc·sign(i_x), the textbook
+//! (t_d/T_pwm)·U_dc. The
 //! sign fades linearly within a small current band: there the ripple current reverses within
 //! the period and the error shrinks. The motor sees the pole voltages less their mean (the
 //! star point floats), transformed to d-q with the amplitude-invariant Clarke and Park
@@ -30,7 +34,7 @@ impl Inverter {
     pub fn new(p: &InverterParams) -> Inverter {
         Inverter {
             u_dc_v: p.u_dc_v,
-            dead_time_error_v: 2.0 * p.dead_time_s * p.pwm_frequency_hz * p.u_dc_v,
+            dead_time_error_v: p.dead_time_s * p.pwm_frequency_hz * p.u_dc_v,
             band_a: p.dead_time_current_band_a,
         }
     }

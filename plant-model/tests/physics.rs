@@ -625,3 +625,39 @@ fn sensors_quantise_and_wrap_like_the_peripherals() {
     let count = plant.sample().encoder_count;
     assert!((count as i64 - 5000).abs() <= 2, "count {count}");
 }
+
+#[test]
+fn dead_time_costs_one_dead_interval_per_pwm_period() {
+    // A switching-level leg over one centre-aligned PWM period, independent of the average
+    // model: the upper switch's gate is on while the triangular carrier is below the duty,
+    // each turn-on delayed by t_d; while both gates are off, a positive current flows
+    // through the lower diode (pole at 0 V). The pole's mean voltage falls short of
+    // d·U_dc by t_d·f·U_dc: the falling edge loses nothing.
+    use plant_model::inverter::Inverter;
+    let rig = Rig::nominal();
+    let mut p = rig.inverter.clone();
+    p.dead_time_s = 1.5e-6;
+    let (t_pwm, t_d, u_dc, duty) = (1.0 / p.pwm_frequency_hz, p.dead_time_s, p.u_dc_v, 0.6);
+    let n = 200_000;
+    let mut sum = 0.0;
+    for k in 0..n {
+        let t = (k as f64 + 0.5) / n as f64 * t_pwm;
+        // The upper gate's command: the carrier 0 → 1 → 0 over the period below the duty.
+        let upper_cmd = |t: f64| {
+            let c = 1.0 - (2.0 * t.rem_euclid(t_pwm) / t_pwm - 1.0).abs();
+            c < duty
+        };
+        // The upper switch conducts only if commanded now and for the last t_d.
+        let upper_on = upper_cmd(t) && upper_cmd(t - t_d);
+        // The lower switch conducts when commanded off now and for the last t_d; otherwise
+        // (dead time) the positive current takes the lower diode: pole at 0 either way.
+        sum += if upper_on { u_dc } else { 0.0 };
+    }
+    let mean = sum / n as f64;
+    let loss_switching = duty * u_dc - mean;
+    let average = Inverter::new(&p).pole_voltages(&[duty; 3], &[10.0, -5.0, -5.0])[0];
+    let loss_average = duty * u_dc - average;
+    let textbook = t_d / t_pwm * u_dc;
+    assert!((loss_switching - textbook).abs() < 0.01 * textbook, "{loss_switching} vs {textbook}");
+    assert!((loss_average - textbook).abs() < 1e-9 * textbook, "{loss_average} vs {textbook}");
+}

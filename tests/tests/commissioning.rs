@@ -204,7 +204,7 @@ fn a_resistance_far_from_the_nameplate_is_implausible() {
 
 #[test]
 fn two_current_levels_cancel_the_dead_time_voltage_error() {
-    // 1 µs dead time at 20 kHz and 280 V: 2·t_d·f·U_dc = 11.2 V per leg, of the order of
+    // 1 µs dead time at 20 kHz and 280 V: t_d·f·U_dc = 5.6 V per leg, of the order of
     // R_s·8 A ≈ 8 V: U/I at one level would be far off; ΔU/ΔI is not.
     let mut rig = perturbed(21);
     rig.inverter.dead_time_s = 1e-6;
