@@ -376,6 +376,14 @@ impl Controller {
         self.sup.trip(FaultCode::Watchdog);
     }
 
+    /// Break entry point: the application calls this from the PWM timer's break interrupt
+    /// (the hardware over-current comparators switched the gates off). Latches
+    /// [`FaultCode::HardwareBreak`] and drops the mode to Disabled at once; the next
+    /// [`Controller::on_current_sample`] returns disabled PWM, which re-arms the break.
+    pub fn report_hardware_break(&mut self) {
+        self.sup.trip(FaultCode::HardwareBreak);
+    }
+
     /// Pressure from the ADC result (gauge). [Pa]
     #[inline]
     fn pressure_pa(&self, counts: f32) -> f32 {

@@ -91,11 +91,15 @@ pub enum FaultCode {
     /// The stored parameter table was corrupt, of another version or inconsistent: the
     /// defaults were loaded instead. (16)
     ParameterStoreInvalid = 16,
+    /// The bridge's hardware over-current break (current comparators into the PWM
+    /// timer's break input) switched the gates off; the application reports it
+    /// ([`crate::Controller::report_hardware_break`]). (17)
+    HardwareBreak = 17,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 16] = [
+    pub const ALL: [FaultCode; 17] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -112,9 +116,10 @@ impl FaultCode {
         FaultCode::CommissioningImplausible,
         FaultCode::CommissioningEncoder,
         FaultCode::ParameterStoreInvalid,
+        FaultCode::HardwareBreak,
     ];
 
-    /// Telemetry code (1..=16).
+    /// Telemetry code (1..=17).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -125,7 +130,7 @@ impl FaultCode {
     }
 
     /// Bit in a [`Conditions`] mask.
-    pub fn bit(self) -> u16 {
+    pub fn bit(self) -> u32 {
         1 << (self as u8 - 1)
     }
 
@@ -142,6 +147,7 @@ impl FaultCode {
                 | FaultCode::CommissioningImplausible
                 | FaultCode::CommissioningEncoder
                 | FaultCode::ParameterStoreInvalid
+                | FaultCode::HardwareBreak
         )
     }
 }
@@ -167,6 +173,7 @@ impl fmt::Display for FaultCode {
                 "commissioning: encoder reversed or shaft not moving"
             }
             FaultCode::ParameterStoreInvalid => "stored parameters invalid, defaults loaded",
+            FaultCode::HardwareBreak => "hardware over-current break",
         };
         write!(f, "fault {}: {}", self.code(), s)
     }
@@ -174,7 +181,7 @@ impl fmt::Display for FaultCode {
 
 /// Set of fault conditions present in one sample (bit = [`FaultCode::bit`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Conditions(pub u16);
+pub struct Conditions(pub u32);
 
 impl Conditions {
     /// Adds `f` when `present`.
@@ -312,18 +319,20 @@ mod tests {
 
     #[test]
     fn codes_round_trip_and_bits_are_distinct() {
-        let mut seen = 0u16;
+        let mut seen = 0u32;
         for f in FaultCode::ALL {
             assert_eq!(FaultCode::from_code(f.code()), Some(f));
             assert_eq!(seen & f.bit(), 0);
             seen |= f.bit();
         }
         assert_eq!(FaultCode::from_code(0), None);
-        // Code 16 is the documented parameter-store fault.
+        // Code 16 is the documented parameter-store fault, 17 the hardware break.
         assert_eq!(
             FaultCode::from_code(16),
             Some(FaultCode::ParameterStoreInvalid)
         );
+        assert_eq!(FaultCode::from_code(17), Some(FaultCode::HardwareBreak));
+        assert_eq!(FaultCode::from_code(18), None);
         for m in [
             Mode::Disabled,
             Mode::Calibrating,
@@ -355,6 +364,38 @@ mod tests {
         assert_eq!(s.clear(), Ok(()));
         assert_eq!(s.fault(), None);
         assert_eq!(s.mode(), Mode::Disabled);
+    }
+
+    #[test]
+    fn a_hardware_break_latches_its_own_code_until_cleared() {
+        use crate::{Command, Config, Controller, Measurements};
+        let healthy = Measurements {
+            adc_dc_link: 2800,
+            adc_pressure: 6554 + 6291, // 3 MPa
+            ..Measurements::default()
+        };
+        let mut c = Controller::new(&Config::nominal());
+        c.on_current_sample(&healthy);
+        c.command(Command::SetMode(Mode::Speed)).unwrap();
+        assert!(c.on_current_sample(&healthy).pwm_enabled);
+        // The break interrupt between two current-loop calls.
+        c.report_hardware_break();
+        assert_eq!(c.fault(), Some(FaultCode::HardwareBreak));
+        assert_eq!(c.telemetry().fault.map(FaultCode::code), Some(17));
+        for _ in 0..10 {
+            assert!(!c.on_current_sample(&healthy).pwm_enabled);
+            c.command(Command::Heartbeat).unwrap();
+        }
+        assert_eq!(
+            c.command(Command::SetMode(Mode::Speed)),
+            Err(crate::CommandError::Mode(ModeRefusal::Faulted(
+                FaultCode::HardwareBreak
+            )))
+        );
+        // The comparators' cause is not visible to the core: the clear is the operator's.
+        c.command(Command::ClearFaults).unwrap();
+        c.command(Command::SetMode(Mode::Speed)).unwrap();
+        assert!(c.on_current_sample(&healthy).pwm_enabled);
     }
 
     #[test]
