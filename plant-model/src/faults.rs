@@ -47,8 +47,11 @@
 //! connects the two motor terminals — the motor is then one circuit along n_z (z the third
 //! phase, floating) closed through R_f, v_n = −(R_f/2)·i, and brakes the shaft with its
 //! back-EMF; a rail short's current free-wheels through the leg's diode (v_f = 0, decaying
-//! with τ_f) and pins its phase's pole at the rail. Diode conduction driven by a back-EMF
-//! above U_dc (beyond the speed limit) is not modelled in these two states.
+//! with τ_f) and pins its phase's pole at the rail, so a turning motor drives its back-EMF
+//! through the short and the other legs' diodes: the shorted phase's current then comes
+//! from the short, not from its leg, unless it flows the way the leg's diode to the same
+//! rail conducts (that diode, not the resistive short, takes it). Diode conduction driven
+//! by a back-EMF above U_dc (beyond the speed limit) is not modelled in these two states.
 //!
 //! # DC-link supply
 //!

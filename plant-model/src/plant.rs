@@ -48,7 +48,7 @@
 use crate::accumulator::ATMOSPHERE_PA;
 use crate::accumulator::{Absorber, GasCharge};
 use crate::cylinder::Cylinder;
-use crate::faults::{DcLink, Line, PlantFaults, PUMP_MANIFOLD_VOLUME_M3};
+use crate::faults::{DcLink, PlantFaults, PUMP_MANIFOLD_VOLUME_M3};
 use crate::friction::{Friction, Slip};
 use crate::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use crate::motor::{MagnetFlux, Motor, Phasor};
@@ -923,8 +923,8 @@ impl Plant {
         if let Some(line) = line {
             self.project_line(line);
         }
-        // A short across two phases keeps the motor's circuit closed with the bridge off.
-        let closed_by_short = matches!(line, Some(Line::Shorted { .. }));
+        // A short keeps the motor's circuit closed with the bridge off.
+        let closed_by_short = self.faulted && self.short_closes_circuit(line);
         if let (Drive::Inverter { enabled: false, .. }, false) = (inputs.drive, closed_by_short) {
             let (id, iq) = (self.x[ix::ID], self.x[ix::IQ]);
             let emf = self
@@ -964,7 +964,6 @@ impl Plant {
             self.inverter
                 .set_u_dc(self.dc_link.voltage(self.t_s + k as f64 * h));
             self.impose(&inputs);
-            let i_fault0 = self.i_fault;
             let mut left = h;
             if let Some(t_break) = self.break_within(h, &inputs) {
                 self.step_with_events(t_break, &inputs);
@@ -975,7 +974,7 @@ impl Plant {
             self.step_with_events(left, &inputs);
             self.advance_fault_path(left, &inputs);
             self.dc_link.advance(h);
-            self.after_step(h, i_fault0, &mut inputs);
+            self.after_step(h, &mut inputs);
         }
     }
 
@@ -1034,7 +1033,7 @@ impl Plant {
             None
         };
         // Died out stays out, unless a short across two phases keeps the circuit closed.
-        let shorted = matches!(line, Some(Line::Shorted { .. }));
+        let shorted = self.faulted && self.short_closes_circuit(line);
         if !enabled && self.discrete.extinguished && !shorted {
             return Electrical::default();
         }

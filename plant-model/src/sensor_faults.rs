@@ -4,9 +4,10 @@
 //!
 //! # Encoder (quadrature A/B with an index Z, counted by the timer)
 //!
-//! - **Lost counts**: edges the counter missed (an edge faster than its input filter, a
-//!   glitch): the count is short by `counts` from then on. Counts lost are not found again;
-//!   only a re-reference (the index, an alignment) removes the offset.
+//! - **Lost counts**: edges the counter missed (edges faster than its input filter during a
+//!   disturbance), at most [`LOST_COUNTS_PER_SAMPLE`] per sample until `counts` are gone:
+//!   the count is short by them from then on. Counts lost are not found again; only a
+//!   re-reference (the index, an alignment) removes the offset.
 //! - **Noise burst**: spurious edges from interference on A/B while it lasts: each sample
 //!   the counter gains or loses a Gaussian number of counts (rms `counts_rms`), which stay.
 //! - **Stuck count**: A and B lost (a broken wire, a dead line receiver): the counter stops;
@@ -34,6 +35,9 @@
 //!   setting), below the ADC's own range.
 
 use crate::faults::Phase;
+
+/// Most edges the counter misses per sample. [counts]
+pub const LOST_COUNTS_PER_SAMPLE: i64 = 2;
 
 /// A fault of the encoder.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -150,6 +154,8 @@ impl SensorFaults {
 pub struct SensorFaultState {
     /// Counts the counter is off by (lost counts, noise bursts). [counts]
     pub encoder_offset: i64,
+    /// Counts still to be lost. [counts]
+    pub encoder_losing: i64,
     /// The count the counter stopped at, or swapped at. [counts]
     pub encoder_hold: Option<u32>,
     /// The transducer's frozen pressure. [Pa]

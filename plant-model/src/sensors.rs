@@ -13,6 +13,7 @@
 use crate::rig::SensorParams;
 use crate::sensor_faults::{
     CurrentFault, EncoderFault, PressureFault, SensorFaultState, SensorFaults,
+    LOST_COUNTS_PER_SAMPLE,
 };
 use core::f64::consts::PI;
 use rand_core::{RngCore, SeedableRng};
@@ -74,10 +75,11 @@ impl Sensors {
         if faults.encoder != self.faults.encoder {
             st.encoder_hold = None;
             match faults.encoder {
-                None => st.encoder_offset = 0,
-                Some(EncoderFault::LostCounts { counts }) => {
-                    st.encoder_offset -= i64::from(counts);
+                None => {
+                    st.encoder_offset = 0;
+                    st.encoder_losing = 0;
                 }
+                Some(EncoderFault::LostCounts { counts }) => st.encoder_losing = i64::from(counts),
                 _ => {}
             }
         }
@@ -215,6 +217,13 @@ impl Sensors {
         let n = i64::from(self.params.encoder.counts_per_rev.max(1));
         let wrap = |c: i64| c.rem_euclid(n) as u32;
         let st = &mut self.fault_state;
+        if st.encoder_losing != 0 {
+            let lost = st
+                .encoder_losing
+                .clamp(-LOST_COUNTS_PER_SAMPLE, LOST_COUNTS_PER_SAMPLE);
+            st.encoder_losing -= lost;
+            st.encoder_offset -= lost;
+        }
         let (raw, index) = match self.faults.encoder {
             None | Some(EncoderFault::LostCounts { .. }) => (i64::from(count), index),
             Some(EncoderFault::NoiseBurst { counts_rms }) => {

@@ -29,9 +29,6 @@ use crate::sensor_faults::SensorFaults;
 /// √3.
 const SQRT3: f64 = 1.732_050_807_568_877_2;
 
-/// Points per integration step at which the watch evaluates a short circuit's current.
-const WATCH_POINTS: u32 = 10;
-
 /// The hardware break and the current watch.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Protection {
@@ -151,17 +148,36 @@ impl Plant {
     /// The currents through the bridge legs (and the current sensors): the motor's phase
     /// currents plus a short circuit's path current. [A]
     pub(super) fn leg_currents(&self, i_motor: [f64; 3]) -> [f64; 3] {
-        match self.faults.short {
-            Some(s) if self.i_fault != 0.0 => {
-                let add = leg_contribution(s.path, self.i_fault);
-                [
-                    i_motor[0] + add[0],
-                    i_motor[1] + add[1],
-                    i_motor[2] + add[2],
-                ]
-            }
-            _ => i_motor,
+        self.legs_with(i_motor, self.i_fault)
+    }
+
+    /// The bridge legs' currents for the motor's phase currents `i_motor` and a fault-path
+    /// current `i_f`. [A]
+    fn legs_with(&self, i_motor: [f64; 3], i_f: f64) -> [f64; 3] {
+        let Some(s) = self.faults.short else {
+            return i_motor;
+        };
+        let add = leg_contribution(s.path, i_f);
+        let mut legs = [
+            i_motor[0] + add[0],
+            i_motor[1] + add[1],
+            i_motor[2] + add[2],
+        ];
+        // With the gates off a rail short feeds its phase's motor current itself, unless
+        // that current flows the way the leg's diode to the same rail conducts.
+        let off = matches!(
+            self.last_inputs.drive,
+            Drive::Inverter { enabled: false, .. }
+        );
+        if let (true, ShortPath::PhaseToRail { phase, rail }) = (off, s.path) {
+            let i = i_motor[phase.index()];
+            let through_diode = match rail {
+                crate::faults::Rail::Positive => i.min(0.0),
+                crate::faults::Rail::Negative => i.max(0.0),
+            };
+            legs[phase.index()] = through_diode + add[phase.index()];
         }
+        legs
     }
 
     /// The motor's phase currents now. [A]
@@ -214,6 +230,21 @@ impl Plant {
         (did, diq, v_n, i)
     }
 
+    /// Whether a short keeps the motor's circuit closed with the bridge off (`line`: the
+    /// line confinement in force): across two phases it closes the line, to a rail it pins a
+    /// terminal so the back-EMF always finds a diode to drive through.
+    #[inline]
+    pub(super) fn short_closes_circuit(&self, line: Option<Line>) -> bool {
+        matches!(line, Some(Line::Shorted { .. }))
+            || matches!(
+                self.faults.short,
+                Some(crate::faults::Short {
+                    path: ShortPath::PhaseToRail { .. },
+                    ..
+                })
+            )
+    }
+
     /// A rail short pins its phase's pole at the rail while the bridge is off.
     #[inline]
     pub(super) fn pin_shorted_pole(&self, v_pole: &mut [f64; 3]) {
@@ -260,12 +291,53 @@ impl Plant {
         }
     }
 
-    /// Advances the fault path's current by `h` with `inputs` held. [s]
+    /// Advances the fault path's current by `h` with `inputs` held, and books what the
+    /// current watch sees of it. [s]
     pub(super) fn advance_fault_path(&mut self, h: f64, inputs: &Inputs) {
-        if let Some(s) = self.faults.short {
-            let v = self.fault_path_drive(inputs);
-            self.i_fault = fault_path_current(&s, self.i_fault, v, self.inverter.u_dc_v, h);
-        }
+        let Some(s) = self.faults.short else {
+            return;
+        };
+        let v = self.fault_path_drive(inputs);
+        let u = self.inverter.u_dc_v;
+        let i0 = self.i_fault;
+        self.i_fault = fault_path_current(&s, i0, v, u, h);
+        let Some(limit) = self.protection.watch_limit_a else {
+            return;
+        };
+        // The motor's currents barely move within a step; the path's is an exponential
+        // toward a fixed value (or to zero through the diodes), monotone, so a leg's current
+        // crosses the limit at most once unless it is above it at both ends.
+        let motor = self.motor_phase_currents();
+        let leg_max = |i_f: f64| {
+            self.legs_with(motor, i_f)
+                .iter()
+                .fold(0.0f64, |m, i| m.max(libm::fabs(*i)))
+        };
+        let (a, b) = (leg_max(i0), leg_max(self.i_fault));
+        let above = match (a > limit, b > limit) {
+            (false, false) => 0.0,
+            (true, true) => h,
+            (rising_out, _) => {
+                let (mut lo, mut hi) = (0.0, h);
+                while hi - lo > 1e-9 {
+                    let mid = 0.5 * (lo + hi);
+                    let out = leg_max(fault_path_current(&s, i0, v, u, mid)) > limit;
+                    if out == rising_out {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                if rising_out {
+                    hi
+                } else {
+                    h - hi
+                }
+            }
+        };
+        let w = &mut self.protection;
+        w.peak_a = w.peak_a.max(a).max(b);
+        w.time_above_s += above;
     }
 
     /// When within the next `h` seconds a short circuit's current takes a leg to the break
@@ -280,8 +352,9 @@ impl Plant {
         let motor = self.motor_phase_currents();
         let legs_at = |t: f64| {
             let i_f = fault_path_current(&s, self.i_fault, Some(v), self.inverter.u_dc_v, t);
-            let add = leg_contribution(s.path, i_f);
-            (0..3).fold(0.0f64, |m, k| m.max(libm::fabs(motor[k] + add[k])))
+            self.legs_with(motor, i_f)
+                .iter()
+                .fold(0.0f64, |m, i| m.max(libm::fabs(*i)))
         };
         if legs_at(h) < threshold {
             return None;
@@ -327,9 +400,9 @@ impl Plant {
     }
 
     /// After an integration step of `h` seconds: the break against slower over-currents
-    /// (checked at the step's end) and the watch's books. `i_fault0` is the path current at
-    /// the step's start. [s], [A]
-    pub(super) fn after_step(&mut self, h: f64, i_fault0: f64, inputs: &mut Inputs) {
+    /// (checked at the step's end) and, without a short circuit (whose path current
+    /// [`Plant::advance_fault_path`] watches), the watch's books. [s]
+    pub(super) fn after_step(&mut self, h: f64, inputs: &mut Inputs) {
         let p = self.protection;
         if p.break_threshold_a.is_none() && p.watch_limit_a.is_none() {
             return;
@@ -346,23 +419,12 @@ impl Plant {
         let Some(limit) = p.watch_limit_a else {
             return;
         };
-        // A short's path current moves within the step: watch it at points between.
-        let (mut above, mut top) = (0u32, peak);
-        match self.faults.short {
-            Some(s) if i_fault0 != 0.0 || self.i_fault != 0.0 => {
-                for k in 1..=WATCH_POINTS {
-                    let t = h * k as f64 / WATCH_POINTS as f64;
-                    let i_f = i_fault0 + (self.i_fault - i_fault0) * (t / h);
-                    let add = leg_contribution(s.path, i_f);
-                    let m = (0..3).fold(0.0f64, |m, j| m.max(libm::fabs(motor[j] + add[j])));
-                    top = top.max(m);
-                    above += u32::from(m > limit);
-                }
+        if self.faults.short.is_none() {
+            let w = &mut self.protection;
+            w.peak_a = w.peak_a.max(peak);
+            if peak > limit {
+                w.time_above_s += h;
             }
-            _ => above = if peak > limit { WATCH_POINTS } else { 0 },
         }
-        let w = &mut self.protection;
-        w.peak_a = w.peak_a.max(top);
-        w.time_above_s += h * f64::from(above) / f64::from(WATCH_POINTS);
     }
 }
