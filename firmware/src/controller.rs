@@ -30,6 +30,7 @@ use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
 use crate::io::{Measurements, Outputs};
 use crate::parameters::{self, ParamError, ParamId, TableError, COUNT};
 use crate::pi::saturate;
+use crate::plausibility::{current_sum_off, StallMonitor};
 use crate::pressure_loop::PressureLoop;
 use crate::speed_loop::SpeedLoop;
 use crate::speed_observer::SpeedObserver;
@@ -210,6 +211,8 @@ pub struct Controller {
     state: CurrentLoopState,
     command_status: u8,
     calibrated: bool,
+    /// The current offsets were measured (the first phase of a calibration).
+    offsets_measured: bool,
     commissioning: Commissioning,
     commission_requested: bool,
     /// Open-loop voltage commissioning asked for this period. [V]
@@ -218,6 +221,7 @@ pub struct Controller {
     /// The current loop runs at a forced angle this period (no speed decoupling).
     forced_frame: bool,
     step: Option<ActiveStep>,
+    stall: StallMonitor,
 }
 
 impl Controller {
@@ -275,12 +279,14 @@ impl Controller {
             state: CurrentLoopState::default(),
             command_status: 0,
             calibrated: false,
+            offsets_measured: false,
             commissioning: Commissioning::new(config),
             commission_requested: false,
             open_loop_voltage: None,
             commission_speed_on: false,
             forced_frame: false,
             step: None,
+            stall: StallMonitor::new(config.limits.stall_time_s, pwm),
         }
     }
 
@@ -346,6 +352,11 @@ impl Controller {
     /// True once a calibration has completed.
     pub fn is_calibrated(&self) -> bool {
         self.calibrated
+    }
+
+    /// True once a calibration has measured the current offsets (its first phase).
+    pub fn offsets_measured(&self) -> bool {
+        self.offsets_measured
     }
 
     /// Zero-current ADC results in use. [counts]
@@ -534,6 +545,26 @@ impl Controller {
             FaultCode::CommandTimeout,
             mode.is_active() && self.since_command > self.d.timeout_calls,
         );
+        // Until the offsets are measured each channel may be off by the calibration's
+        // tolerance.
+        let offsets_a = if self.offsets_measured {
+            0.0
+        } else {
+            3.0 * self.cfg.calibration.offset_max_lsb * s.current_a_per_lsb
+        };
+        conditions.set(
+            FaultCode::PhaseCurrentSum,
+            current_sum_off(&self.state.i_abc, l.current_sum_a + offsets_a),
+        );
+        let sp = &self.cfg.speed;
+        let stalled = self.stall.update(
+            matches!(mode, Mode::Speed | Mode::Pressure),
+            self.iq_ref,
+            sp.iq_limit_a,
+            self.speed.speed(),
+            sp.speed_limit_rad_s,
+        );
+        conditions.set(FaultCode::Stall, stalled);
 
         let still_on = self.sup.check(conditions);
         self.active_last_call = self.sup.mode().is_active();
@@ -588,6 +619,7 @@ impl Controller {
                         return (false, 0.0, Some(FaultCode::CurrentOffset));
                     }
                     self.current.set_offsets(offsets);
+                    self.offsets_measured = true;
                     self.current.reset();
                     self.calibration = if self.commission_requested {
                         self.commissioning.start();

@@ -95,11 +95,19 @@ pub enum FaultCode {
     /// timer's break input) switched the gates off; the application reports it
     /// ([`crate::Controller::report_hardware_break`]). (17)
     HardwareBreak = 17,
+    /// The three phase currents do not sum to zero within `limits.current_sum_a`: a current
+    /// channel stuck, off in gain or clipping, or current leaving the star through a short
+    /// to a rail or earth. (18)
+    PhaseCurrentSum = 18,
+    /// The q-current reference at its limit for `limits.stall_time_s` with the shaft
+    /// measured below a tenth of the speed limit: a locked rotor, or an encoder that does
+    /// not see the shaft turn (stuck, reversed). (19)
+    Stall = 19,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 17] = [
+    pub const ALL: [FaultCode; 19] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -117,9 +125,11 @@ impl FaultCode {
         FaultCode::CommissioningEncoder,
         FaultCode::ParameterStoreInvalid,
         FaultCode::HardwareBreak,
+        FaultCode::PhaseCurrentSum,
+        FaultCode::Stall,
     ];
 
-    /// Telemetry code (1..=17).
+    /// Telemetry code (1..=19).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -148,6 +158,7 @@ impl FaultCode {
                 | FaultCode::CommissioningEncoder
                 | FaultCode::ParameterStoreInvalid
                 | FaultCode::HardwareBreak
+                | FaultCode::Stall
         )
     }
 }
@@ -174,6 +185,10 @@ impl fmt::Display for FaultCode {
             }
             FaultCode::ParameterStoreInvalid => "stored parameters invalid, defaults loaded",
             FaultCode::HardwareBreak => "hardware over-current break",
+            FaultCode::PhaseCurrentSum => {
+                "phase currents do not sum to zero (current sensor or earth fault)"
+            }
+            FaultCode::Stall => "stall: current at its limit, shaft not turning",
         };
         write!(f, "fault {}: {}", self.code(), s)
     }
@@ -332,7 +347,8 @@ mod tests {
             Some(FaultCode::ParameterStoreInvalid)
         );
         assert_eq!(FaultCode::from_code(17), Some(FaultCode::HardwareBreak));
-        assert_eq!(FaultCode::from_code(18), None);
+        assert_eq!(FaultCode::from_code(19), Some(FaultCode::Stall));
+        assert_eq!(FaultCode::from_code(20), None);
         for m in [
             Mode::Disabled,
             Mode::Calibrating,

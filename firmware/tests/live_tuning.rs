@@ -23,7 +23,11 @@ fn at_rest() -> Measurements {
 }
 
 fn running(mode: Mode) -> Controller {
-    let mut c = Controller::new(&Config::nominal());
+    // The encoder stands still while the loops ask for torque, for seconds: a stall to the
+    // supervisor, which these tests of the loops' arithmetic keep out of the way.
+    let mut cfg = Config::nominal();
+    cfg.limits.stall_time_s = 3600.0;
+    let mut c = Controller::new(&cfg);
     c.on_current_sample(&at_rest());
     c.command(Command::SetMode(mode)).expect("mode");
     // The first active period resets the loops for a start from rest.
