@@ -185,6 +185,8 @@ impl Bench {
         let t = self.time_s();
         self.bus.run_until(t, self.cl.controller_mut());
         let mode = self.cl.controller_mut().mode();
+        let calibrated = self.cl.controller_mut().offsets_measured();
+        let offsets_lsb = self.cl.controller_mut().current_offsets();
         let latched_before = self.cl.plant().break_latched();
         let mut seen = Measurements::default();
         let sample = self.cl.step_with(|m| {
@@ -201,6 +203,9 @@ impl Bench {
             broke,
             silent_s: t - self.bus.last_command_s,
             mode,
+            i_dq_a: (sample.truth.i_d_a, sample.truth.i_q_a),
+            calibrated,
+            offsets_lsb,
         });
         self.calls += 1;
         Step {

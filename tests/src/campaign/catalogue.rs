@@ -234,8 +234,9 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 };
                 ShortPath::PhaseToRail { phase: from, rail }
             };
-            // From a bolted short to a resistive insulation fault.
-            let r = rng.log_uniform(0.02, 2.0);
+            // From a bolted short to a resistive insulation fault whose current stays
+            // below the over-current trip.
+            let r = rng.log_uniform(0.02, 20.0);
             let l = rng.log_uniform(1e-6, 10e-6);
             let f = PlantFaults {
                 short: Some(Short {

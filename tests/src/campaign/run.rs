@@ -250,6 +250,7 @@ pub fn run_case(base: &Bench, index: usize, fault: &Fault, seed: u64) -> Outcome
     // The same bench without the fault, step for step: what the fault changed.
     let mut twin = b.clone();
     let restore = inject(&mut b, fault, seed);
+    b.spec.injected();
     let mut o = Outcome {
         index,
         class: fault.class,
@@ -346,36 +347,39 @@ pub fn run_case(base: &Bench, index: usize, fault: &Fault, seed: u64) -> Outcome
 }
 
 /// The verdict from the rules that fired and the latch.
+/// The verdict from the rules that fired and the latch: the first rule that requires a
+/// code sets the deadline; a code answering any rule fired by then (one that only permits
+/// it included) is a right code.
 fn judge(o: &mut Outcome, fired: &[Fired], latch: Option<u64>) {
-    o.rule = fired.first().map(|f| f.rule);
-    let Some(first) = fired.first() else {
-        o.verdict = if o.latched.is_some() {
-            Verdict::Unpredicted
+    let first_must = fired.iter().find(|f| f.must);
+    o.rule = first_must.or(fired.first()).map(|f| f.rule);
+    let (Some(l), Some(code)) = (latch, o.latched) else {
+        o.verdict = if first_must.is_some() {
+            Verdict::Missed
         } else {
             Verdict::RodeThrough
         };
-        return;
-    };
-    let (Some(l), Some(code)) = (latch, o.latched) else {
-        o.verdict = Verdict::Missed;
         return;
     };
     let answering = fired
         .iter()
         .filter(|f| f.period <= l && f.codes.contains(&code))
         .min_by_key(|f| f.period);
-    match answering {
-        None => o.verdict = Verdict::WrongCode,
-        Some(r) => {
-            o.from_visible_s = Some((l - first.period) as f64 * PWM_PERIOD_S);
-            let _ = r;
-            o.verdict = if l <= first.period + first.deadline {
-                Verdict::Detected
-            } else {
-                Verdict::Late
-            };
-        }
+    let Some(a) = answering else {
+        o.verdict = if first_must.is_some() {
+            Verdict::WrongCode
+        } else {
+            Verdict::Unpredicted
+        };
+        return;
+    };
+    if a.must {
+        o.from_visible_s = Some((l - a.period) as f64 * PWM_PERIOD_S);
     }
+    o.verdict = match first_must {
+        Some(m) if l > m.period.saturating_add(m.deadline) => Verdict::Late,
+        _ => Verdict::Detected,
+    };
 }
 
 /// The repair, the clear and the restart over the bus, then the drive must run.

@@ -12,6 +12,8 @@
 //! | transducer | the reading below the open-wire or above the short level, or a pressure above the over-pressure level | 5 / 6 / 4 | 0 |
 //! | encoder | a count step beyond the plausible speed's, an index far from count 0, a revolution and its margin without an index | 7, 8 | 0 |
 //! | over-speed (truth) | the shaft above the over-speed level by 2 % | 9 | two speed-loop periods |
+//! | current sum | the three phase-current readings sum beyond the plausible level (plus the offsets' tolerance until they are measured) | 18 | 0 |
+//! | stall (truth) | the bridge has driven 90 % of the q-current limit into a shaft turning below a tenth of the speed limit for 90 % of the stall time | 19 | 30 % of the stall time |
 //! | command timeout | no command reached the drive for longer than the timeout, in an active mode | 10 | 2 |
 //! | watchdog | the application reported an overrun | 11 | 1 |
 //!
@@ -19,7 +21,13 @@
 //! period from cause to gates off); 1, that the next call does (the break and the overrun
 //! are reported between calls). The encoder's plausibility limits are the configured
 //! plausible speed's step per call (⌈ω·N/(2π·f)⌉ + 2 counts) and that plus two for the
-//! index.
+//! index; "the shaft measured" is the encoder's count travel over a speed-loop period.
+//! The current sum is taken with the offsets the drive calibrated.
+//!
+//! Two rules permit a code without requiring it: over-speed as the encoder reads it (the
+//! drive's speed estimate filters the counts, so a burst of spurious counts may or may not
+//! carry it over the level) permits 9; a fault injected during the commissioning sequence
+//! permits the sequence's own checks (12–15).
 
 use firmware::{Config, FaultCode, Measurements, Mode};
 
@@ -32,6 +40,8 @@ pub struct Fired {
     pub codes: &'static [FaultCode],
     /// Calls after `period` by which one must be latched. [calls]
     pub deadline: u64,
+    /// A code must answer it (else the rule only permits one).
+    pub must: bool,
     /// Its name.
     pub rule: &'static str,
 }
@@ -48,6 +58,14 @@ const ENC: &[FaultCode] = &[FaultCode::EncoderJump, FaultCode::EncoderIndexLost]
 const OS: &[FaultCode] = &[FaultCode::OverSpeed];
 const TIMEOUT: &[FaultCode] = &[FaultCode::CommandTimeout];
 const WATCHDOG: &[FaultCode] = &[FaultCode::Watchdog];
+const SUM: &[FaultCode] = &[FaultCode::PhaseCurrentSum];
+const STALL: &[FaultCode] = &[FaultCode::Stall];
+const COMMISSIONING: &[FaultCode] = &[
+    FaultCode::CurrentOffset,
+    FaultCode::CommissioningCurrent,
+    FaultCode::CommissioningImplausible,
+    FaultCode::CommissioningEncoder,
+];
 
 /// What one period gives the rules.
 #[derive(Clone, Copy, Debug)]
@@ -66,6 +84,12 @@ pub struct PeriodView<'a> {
     pub silent_s: f64,
     /// The mode the controller was in during the call.
     pub mode: Mode,
+    /// The motor's d-q currents at the sampling instant. [A]
+    pub i_dq_a: (f64, f64),
+    /// The controller has measured its current offsets.
+    pub calibrated: bool,
+    /// The zero-current ADC results the controller uses. [counts]
+    pub offsets_lsb: [f32; 3],
 }
 
 /// The rules' state (the encoder's history) and limits.
@@ -77,6 +101,11 @@ pub struct Spec {
     last_count: Option<u32>,
     since_index: i64,
     watchdog_at: Option<u64>,
+    stall_calls: u64,
+    /// The unwrapped count at the last speed-loop period's calls. [counts]
+    positions: std::collections::VecDeque<i64>,
+    position: i64,
+    injected: bool,
 }
 
 impl Spec {
@@ -93,12 +122,21 @@ impl Spec {
             last_count: None,
             since_index: 0,
             watchdog_at: None,
+            stall_calls: 0,
+            positions: std::collections::VecDeque::new(),
+            position: 0,
+            injected: false,
         }
     }
 
     /// The overrun was reported before call `period`.
     pub fn overrun(&mut self, period: u64) {
         self.watchdog_at = Some(period);
+    }
+
+    /// A fault was injected before the next call.
+    pub fn injected(&mut self) {
+        self.injected = true;
     }
 
     /// Forgets the index history (the drive does so on ClearFaults).
@@ -108,12 +146,14 @@ impl Spec {
 
     /// The rules that fire in this period.
     pub fn evaluate(&mut self, v: &PeriodView) -> Vec<Fired> {
+        let speed = self.count_speed(v.m);
         let mut out = Vec::new();
         let mut fire = |codes, deadline, rule| {
             out.push(Fired {
                 period: v.period,
                 codes,
                 deadline,
+                must: true,
                 rule,
             })
         };
@@ -166,7 +206,74 @@ impl Spec {
         if self.watchdog_at == Some(v.period) {
             fire(WATCHDOG, 1, "overrun");
         }
+        let sum: f32 =
+            v.m.adc_phase_current
+                .iter()
+                .zip(v.offsets_lsb)
+                .map(|(c, o)| (f32::from(*c) - o) * s.current_a_per_lsb)
+                .sum();
+        let allowance = if v.calibrated {
+            0.0
+        } else {
+            3.0 * self.cfg.calibration.offset_max_lsb * s.current_a_per_lsb
+        };
+        // A margin for the f32 arithmetic's order.
+        if sum.abs() > l.current_sum_a + allowance + 1e-3 {
+            fire(SUM, 0, "current sum");
+        }
+        let calls = |t: f32| (t * self.cfg.rates.pwm_hz).round() as u64;
+        let sp = &self.cfg.speed;
+        let driving = (v.i_dq_a.0.hypot(v.i_dq_a.1)) >= 0.9 * f64::from(sp.iq_limit_a);
+        let at_rest = speed.abs() < 0.1 * f64::from(sp.speed_limit_rad_s);
+        let running = matches!(v.mode, Mode::Speed | Mode::Pressure);
+        self.stall_calls = if running && driving && at_rest {
+            self.stall_calls + 1
+        } else {
+            0
+        };
+        if self.stall_calls == calls(0.9 * l.stall_time_s) {
+            fire(STALL, calls(0.3 * l.stall_time_s), "stall");
+        }
+        let mut permit = |codes, rule| {
+            out.push(Fired {
+                period: v.period,
+                codes,
+                deadline: u64::MAX,
+                must: false,
+                rule,
+            })
+        };
+        if speed.abs() > f64::from(l.over_speed_rad_s) {
+            permit(OS, "over-speed (counts)");
+        }
+        if std::mem::take(&mut self.injected) && v.mode == Mode::Calibrating {
+            permit(COMMISSIONING, "commissioning's checks");
+        }
         out
+    }
+
+    /// The shaft's speed as the encoder's counts give it over the last speed-loop period.
+    /// [rad/s]
+    fn count_speed(&mut self, m: &Measurements) -> f64 {
+        let n = i64::from(self.cfg.sensors.encoder_counts_per_rev);
+        let count = i64::from(m.encoder_count) % n;
+        if let Some(last) = self.last_count {
+            let mut delta = count - i64::from(last);
+            if delta >= n / 2 {
+                delta -= n;
+            } else if delta < -n / 2 {
+                delta += n;
+            }
+            self.position += delta;
+        }
+        let window = (self.cfg.rates.pwm_hz / self.cfg.rates.speed_loop_hz).round() as usize;
+        self.positions.push_back(self.position);
+        if self.positions.len() > window + 1 {
+            self.positions.pop_front();
+        }
+        let travel = self.position - self.positions.front().copied().unwrap_or(self.position);
+        let span = (self.positions.len().saturating_sub(1)).max(1) as f64;
+        travel as f64 * std::f64::consts::TAU / n as f64 * f64::from(self.cfg.rates.pwm_hz) / span
     }
 
     /// The encoder's plausibility: a step beyond the plausible speed's, an index far from

@@ -156,7 +156,7 @@ pub fn table(seed: u64, outcomes: &[Outcome]) -> String {
 /// One line about one injection.
 pub fn describe(o: &Outcome) -> String {
     format!(
-        "#{} {} [{}] in {} at {:.4} s: {:?}, rule {:?}, latched {:?} after {} ms; I>lim {:.1} µs, peak p {:.2} MPa (limit {:.2}), PWM after latch {}, NaN {}, rejects to other nodes {}, recovered {} {}",
+        "#{} {} [{}] in {} at {:.4} s: {:?}, rule {:?}, latched {:?} after {} ms; peak I {:.1} A, I>lim {:.1} µs, peak p {:.2} MPa (limit {:.2}); against the twin Δp {:.3} MPa, Δω {:.1} rad/s; PWM after latch {}, NaN {}, rejects to other nodes {}, recovered {} {}",
         o.index,
         o.class.name(),
         o.description,
@@ -166,9 +166,12 @@ pub fn describe(o: &Outcome) -> String {
         o.rule,
         o.latched.map(|f| f.code()),
         ms(o.detect_s),
+        o.peak_current_a,
         o.over_current_s * 1e6,
         o.peak_pressure_pa / 1e6,
         o.pressure_limit_pa / 1e6,
+        o.pressure_error_pa / 1e6,
+        o.speed_error_rad_s,
         o.pwm_after_latch,
         o.nan,
         o.foreign_replies,
