@@ -681,7 +681,7 @@ impl Plant {
         } else {
             self.x[ix::PA]
         };
-        let u_dc = self.dc_link.voltage(self.t_s);
+        let u_dc = self.dc_link_v();
         self.sensors
             .sample(self.t_s, &i_abc, u_dc, p_sensed, self.x[ix::THETA])
     }
@@ -691,7 +691,11 @@ impl Plant {
         let x = &self.x;
         let at = self.angle_terms(x[ix::THETA]);
         // Only the drive side of an evaluation: the hydraulic flows are not observed.
-        let el = self.electrical(x, &self.last_inputs, &at);
+        let el = if self.faulted {
+            self.electrical::<true>(x, &self.last_inputs, &at)
+        } else {
+            self.electrical::<false>(x, &self.last_inputs, &at)
+        };
         let i_abc_a = dq_to_abc(x[ix::ID], x[ix::IQ], at.rot_e.sin, at.rot_e.cos);
         Observables {
             t_s: self.t_s,
@@ -699,7 +703,7 @@ impl Plant {
             i_q_a: x[ix::IQ],
             i_abc_a,
             i_bridge_abc_a: self.leg_currents(i_abc_a),
-            u_dc_v: self.dc_link.voltage(self.t_s),
+            u_dc_v: self.dc_link_v(),
             u_d_v: el.u_d,
             u_q_v: el.u_q,
             theta_m_rad: x[ix::THETA],
@@ -766,8 +770,10 @@ impl Plant {
                 }
                 // A line confinement that begins now (the bridge switched off onto a short)
                 // starts from the line, not from the three-phase currents.
-                if let Some(line) = self.line_mode(enabled).filter(|_| self.faulted) {
-                    self.project_line(line);
+                if self.faulted {
+                    if let Some(line) = self.line_mode(enabled) {
+                        self.project_line(line);
+                    }
                 }
             }
             Drive::Currents { i_d, i_q } => {
@@ -792,13 +798,23 @@ impl Plant {
     }
 
     fn rk4(&mut self, h: f64, inputs: &Inputs) {
+        if self.faulted {
+            self.rk4_with::<true>(h, inputs);
+        } else {
+            self.rk4_with::<false>(h, inputs);
+        }
+    }
+
+    /// [`Plant::rk4`] with the faults' terms (`FAULTED`) or without them compiled in.
+    #[inline(always)]
+    fn rk4_with<const FAULTED: bool>(&mut self, h: f64, inputs: &Inputs) {
         let x0 = self.x;
         let a0 = self.angle_terms(x0[ix::THETA]);
         let stage = |x: &Vector| {
             let a = self.angle_terms_rotated(&a0, x[ix::THETA]);
-            self.derivative_at(x, inputs, &a).0
+            self.derivative_at::<FAULTED>(x, inputs, &a).0
         };
-        let k1 = self.derivative_at(&x0, inputs, &a0).0;
+        let k1 = self.derivative_at::<FAULTED>(&x0, inputs, &a0).0;
         let k2 = stage(&axpy(&x0, 0.5 * h, &k1));
         let k3 = stage(&axpy(&x0, 0.5 * h, &k2));
         let k4 = stage(&axpy(&x0, h, &k3));
@@ -952,13 +968,16 @@ impl Plant {
         if self.sensor_lag_s <= 0.0 {
             self.x[ix::P_SENSOR] = self.x[ix::PA];
         }
-        if !self.faults.pump_port_blocked {
+        if self.faulted && !self.faults.pump_port_blocked {
             self.x[ix::PP] = self.x[ix::PA];
         }
     }
 
     /// [`Plant::advance`]'s `n` steps of `h` with the faults' parts: the DC link's voltage,
-    /// a short circuit's path current, the hardware break, the current watch.
+    /// a short circuit's path current, the hardware break, the current watch. Kept out of
+    /// line so the plain path's step stays inlined.
+    #[cold]
+    #[inline(never)]
     fn advance_faulted(&mut self, n: u64, h: f64, mut inputs: Inputs) {
         for k in 0..n {
             self.inverter
@@ -981,7 +1000,7 @@ impl Plant {
     /// The pump manifold's pressure in state `x`. [Pa]
     #[inline]
     fn pump_pressure(&self, x: &Vector) -> f64 {
-        if self.faults.pump_port_blocked {
+        if self.faulted && self.faults.pump_port_blocked {
             x[ix::PP]
         } else {
             x[ix::PA]
@@ -1016,24 +1035,34 @@ impl Plant {
     /// The right-hand side of the state equations.
     #[inline]
     fn derivative(&self, x: &Vector, inputs: &Inputs) -> (Vector, Aux) {
-        self.derivative_at(x, inputs, &self.angle_terms(x[ix::THETA]))
+        let at = self.angle_terms(x[ix::THETA]);
+        if self.faulted {
+            self.derivative_at::<true>(x, inputs, &at)
+        } else {
+            self.derivative_at::<false>(x, inputs, &at)
+        }
     }
 
     /// The inverter's d-q voltages and the current derivatives (eq. 2) driven by them; zero
     /// unless the inverter drives and the currents are alive. The phase currents are formed
     /// only when the pole voltages depend on them (dead time, free-wheeling diodes).
     #[inline]
-    fn electrical(&self, x: &Vector, inputs: &Inputs, at: &AngleTerms) -> Electrical {
+    fn electrical<const FAULTED: bool>(
+        &self,
+        x: &Vector,
+        inputs: &Inputs,
+        at: &AngleTerms,
+    ) -> Electrical {
         let Drive::Inverter { duties, enabled } = inputs.drive else {
             return Electrical::default();
         };
-        let line = if self.faulted {
+        let line = if FAULTED {
             self.line_mode(enabled)
         } else {
             None
         };
-        // Died out stays out, unless a short across two phases keeps the circuit closed.
-        let shorted = self.faulted && self.short_closes_circuit(line);
+        // Died out stays out, unless a short keeps the circuit closed.
+        let shorted = FAULTED && self.short_closes_circuit(line);
         if !enabled && self.discrete.extinguished && !shorted {
             return Electrical::default();
         }
@@ -1083,7 +1112,12 @@ impl Plant {
 
     /// The right-hand side with the shaft-angle terms `at` of `x` supplied.
     #[inline]
-    fn derivative_at(&self, x: &Vector, inputs: &Inputs, at: &AngleTerms) -> (Vector, Aux) {
+    fn derivative_at<const FAULTED: bool>(
+        &self,
+        x: &Vector,
+        inputs: &Inputs,
+        at: &AngleTerms,
+    ) -> (Vector, Aux) {
         let mut dx = [0.0; ix::N];
         let mut aux = Aux::default();
         let omega = x[ix::OMEGA];
@@ -1091,7 +1125,7 @@ impl Plant {
         let flux = at.flux;
 
         // --- motor and inverter (eq. 1–3, 17–19)
-        let el = self.electrical(x, inputs, at);
+        let el = self.electrical::<FAULTED>(x, inputs, at);
         dx[ix::ID] = el.did;
         dx[ix::IQ] = el.diq;
         let mut p_in = el.p_in;
@@ -1101,7 +1135,7 @@ impl Plant {
 
         // --- pump (eq. 9, 20) and shaft (eq. 4)
         let (p_a, p_b) = (x[ix::PA], x[ix::PB]);
-        let blocked = self.faults.pump_port_blocked;
+        let blocked = FAULTED && self.faults.pump_port_blocked;
         let p_pump = if blocked { x[ix::PP] } else { p_a };
         let factor = at.factor;
         let t_pump = self.pump.load_torque(p_pump, p_b, factor);
@@ -1141,7 +1175,7 @@ impl Plant {
         let q_chk_b = self.check.flow(p_fill - p_b);
         let q_rel_a = self.relief_a.flow(p_pump - p_fill);
         let q_rel_b = self.relief.flow(p_b - p_fill);
-        let q_burst = if self.faulted {
+        let q_burst = if FAULTED {
             self.burst_outflow(p_a)
         } else {
             0.0
@@ -1158,8 +1192,8 @@ impl Plant {
         } else {
             let net_a =
                 q_geo - q_int - q_ext_a - q_cyl + q_chk_a - q_rel_a - q_abs - area * vp - q_burst;
+            // The manifold's state follows port A's at each step's end (`project`).
             dx[ix::PA] = self.beta / v1 * net_a;
-            dx[ix::PP] = dx[ix::PA];
         }
         dx[ix::PB] = self.beta / v2 * net_b;
         dx[ix::FILL_OIL] = q_ext_a + q_ext_b + q_rel_a + q_rel_b - q_chk_a - q_chk_b;

@@ -45,6 +45,8 @@ pub struct Sensors {
     last_revolution: Option<i64>,
     faults: SensorFaults,
     fault_state: SensorFaultState,
+    /// A fault or its remembered state is in force (else the readings take the plain path).
+    faulty: bool,
 }
 
 impl Sensors {
@@ -58,6 +60,7 @@ impl Sensors {
             last_revolution: None,
             faults: SensorFaults::default(),
             fault_state: SensorFaultState::default(),
+            faulty: false,
         }
     }
 
@@ -91,6 +94,8 @@ impl Sensors {
             st.current_hold = None;
         }
         self.faults = faults;
+        self.faulty =
+            faults != SensorFaults::default() || self.fault_state != SensorFaultState::default();
     }
 
     /// Standard normal deviate (Marsaglia's polar method on the xoshiro stream).
@@ -129,6 +134,23 @@ impl Sensors {
         p_sensed: f64,
         theta_m: f64,
     ) -> SensorReadings {
+        if self.faulty {
+            self.sample_with::<true>(t_s, i_abc, u_dc, p_sensed, theta_m)
+        } else {
+            self.sample_with::<false>(t_s, i_abc, u_dc, p_sensed, theta_m)
+        }
+    }
+
+    /// [`Sensors::sample`] with the faults' terms (`FAULTY`) or without them compiled in.
+    #[inline(always)]
+    fn sample_with<const FAULTY: bool>(
+        &mut self,
+        t_s: f64,
+        i_abc: &[f64; 3],
+        u_dc: f64,
+        p_sensed: f64,
+        theta_m: f64,
+    ) -> SensorReadings {
         let c = self.params.current.clone();
         let mut adc_phase_current = [0u16; 3];
         for (k, ((out, i), off)) in adc_phase_current
@@ -138,7 +160,7 @@ impl Sensors {
             .enumerate()
         {
             let n = self.noise(c.noise_a_rms);
-            if self.faults.current.is_none() {
+            if !FAULTY || self.faults.current.is_none() {
                 *out = quantise(c.zero_lsb + (i + off + n) / c.a_per_lsb, c.bits);
                 continue;
             }
@@ -162,7 +184,16 @@ impl Sensors {
         let v = self.params.dc_link.clone();
         let nv = self.noise(v.noise_v_rms);
         let adc_dc_link = quantise((u_dc + nv) / v.v_per_lsb, v.bits);
-        let adc_pressure = self.pressure_reading(t_s, p_sensed);
+        let adc_pressure = if FAULTY {
+            self.pressure_reading(t_s, p_sensed)
+        } else {
+            let p = self.params.pressure.clone();
+            let np = self.noise(p.noise_pa_rms);
+            quantise(
+                p.zero_lsb + (p_sensed + p.offset_pa + np) / p.pa_per_lsb,
+                p.bits,
+            )
+        };
 
         let e = &self.params.encoder;
         let turns = (theta_m + e.offset_rad / self.pole_pairs) / (2.0 * PI);
@@ -172,7 +203,11 @@ impl Sensors {
         let count = ((frac * cpr as f64) as u32).min(cpr - 1);
         let index = matches!(self.last_revolution, Some(r) if r != revolution);
         self.last_revolution = Some(revolution);
-        let (encoder_count, encoder_index) = self.encoder_reading(count, index);
+        let (encoder_count, encoder_index) = if FAULTY {
+            self.encoder_reading(count, index)
+        } else {
+            (count, index)
+        };
         SensorReadings {
             adc_phase_current,
             adc_dc_link,

@@ -147,8 +147,23 @@ impl Plant {
 
     /// The currents through the bridge legs (and the current sensors): the motor's phase
     /// currents plus a short circuit's path current. [A]
+    #[inline]
     pub(super) fn leg_currents(&self, i_motor: [f64; 3]) -> [f64; 3] {
-        self.legs_with(i_motor, self.i_fault)
+        if self.faulted {
+            self.legs_with(i_motor, self.i_fault)
+        } else {
+            i_motor
+        }
+    }
+
+    /// The DC-link voltage now. [V]
+    #[inline]
+    pub(super) fn dc_link_v(&self) -> f64 {
+        if self.faulted {
+            self.dc_link.voltage(self.t_s)
+        } else {
+            self.inverter.u_dc_v
+        }
     }
 
     /// The bridge legs' currents for the motor's phase currents `i_motor` and a fault-path
