@@ -973,30 +973,6 @@ impl Plant {
         }
     }
 
-    /// [`Plant::advance`]'s `n` steps of `h` with the faults' parts: the DC link's voltage,
-    /// a short circuit's path current, the hardware break, the current watch. Kept out of
-    /// line so the plain path's step stays inlined.
-    #[cold]
-    #[inline(never)]
-    fn advance_faulted(&mut self, n: u64, h: f64, mut inputs: Inputs) {
-        for k in 0..n {
-            self.inverter
-                .set_u_dc(self.dc_link.voltage(self.t_s + k as f64 * h));
-            self.impose(&inputs);
-            let mut left = h;
-            if let Some(t_break) = self.break_within(h, &inputs) {
-                self.step_with_events(t_break, &inputs);
-                self.advance_fault_path(t_break, &inputs);
-                self.trip_break(&mut inputs);
-                left -= t_break;
-            }
-            self.step_with_events(left, &inputs);
-            self.advance_fault_path(left, &inputs);
-            self.dc_link.advance(h);
-            self.after_step(h, &mut inputs);
-        }
-    }
-
     /// The pump manifold's pressure in state `x`. [Pa]
     #[inline]
     fn pump_pressure(&self, x: &Vector) -> f64 {

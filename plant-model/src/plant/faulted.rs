@@ -56,6 +56,30 @@ pub struct CurrentWatch {
 }
 
 impl Plant {
+    /// [`Plant::advance`]'s `n` steps of `h` with the faults' parts: the DC link's voltage,
+    /// a short circuit's path current, the hardware break, the current watch. Kept out of
+    /// line so the plain path's step stays inlined.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn advance_faulted(&mut self, n: u64, h: f64, mut inputs: Inputs) {
+        for k in 0..n {
+            self.inverter
+                .set_u_dc(self.dc_link.voltage(self.t_s + k as f64 * h));
+            self.impose(&inputs);
+            let mut left = h;
+            if let Some(t_break) = self.break_within(h, &inputs) {
+                self.step_with_events(t_break, &inputs);
+                self.advance_fault_path(t_break, &inputs);
+                self.trip_break(&mut inputs);
+                left -= t_break;
+            }
+            self.step_with_events(left, &inputs);
+            self.advance_fault_path(left, &inputs);
+            self.dc_link.advance(h);
+            self.after_step(h, &mut inputs);
+        }
+    }
+
     /// Switches the plant's faults from now on (`Err` names an invalid field; nothing
     /// changes then). Opening a phase removes its current at once; blocking the pump's port
     /// gives its manifold a node of its own at the port's pressure.
