@@ -12,7 +12,7 @@
 //!
 //! The writer checks the same rules first (so every file it writes reads back), writes the
 //! values in shortest round-trip notation and replaces the target atomically
-//! ([`crate::atomic_file`]): a failed write leaves no partial file.
+//! ([`crate::output::atomic`]): a failed write leaves no partial file.
 
 use std::fmt::Write as _;
 use std::fs::File;
@@ -586,7 +586,7 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
 /// of the columns present, one row per sample in shortest round-trip notation.
 pub fn write(path: &Path, log: &BenchLog) -> Result<(), BenchLogError> {
     log.check(path)?;
-    crate::atomic_file::write_with(path, |w| write_to(w, log)).map_err(|source| {
+    crate::output::atomic::write_with(path, |w| write_to(w, log)).map_err(|source| {
         BenchLogError::Write {
             file: path.to_path_buf(),
             source,

@@ -14,12 +14,24 @@
 //! diagnose` and `eha tune`; re-capturing (or cutting the log at the reset) is the fix.
 
 use crate::bench_log::{self, BenchLog, Signal, MIN_ROWS};
-use crate::cli::{CliError, IngestArgs};
+use crate::output::CliError;
+use clap::Args;
 use firmware::telemetry::{parse_line, ParseError, TelemetryFrame, COLUMNS};
 use std::fmt;
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
+
+/// `eha ingest`.
+#[derive(Debug, Args)]
+pub struct IngestArgs {
+    /// The decoder's output (`probe-rs run` or `defmt-print`).
+    #[arg(value_name = "DEFMT_LOG")]
+    pub defmt_log: PathBuf,
+    /// Bench log to write.
+    #[arg(long, value_name = "LOG.csv")]
+    pub out: PathBuf,
+}
 
 /// How many malformed lines the error message lists (all are counted).
 const LISTED: usize = 10;

@@ -7,9 +7,34 @@
 //! and types (line, column and key, from the TOML parser), keys the rig does not have (a
 //! misspelt key would otherwise be ignored silently), then the physics ([`Rig::validate`],
 //! naming the parameter). A file must give every parameter: start from `eha rig > my.toml`.
+//!
+//! `eha rig` ([`run_rig`]) prints a rig in this format.
 
+use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use clap::Args;
 use plant_model::{Rig, RigError};
 use std::path::{Path, PathBuf};
+
+/// `eha rig`.
+#[derive(Debug, Args)]
+pub struct RigArgs {
+    /// Also write the rig as JSON (`-`: standard output, instead of the TOML).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+/// `eha rig`: the TOML on standard output; with `--json PATH` the JSON too (with `--json -`
+/// only the JSON, so standard output stays one parseable document).
+pub fn run_rig(rig: &Rig, a: &RigArgs) -> Result<(), CliError> {
+    if let Some(path) = &a.json {
+        let value = serde_json::to_value(rig).map_err(|e| CliError::Failed(e.to_string()))?;
+        write_json(path, &value)?;
+        if is_stdout(path) {
+            return Ok(());
+        }
+    }
+    print_stdout(&to_toml(rig))
+}
 
 /// A rig file that cannot be used.
 #[derive(Debug, thiserror::Error)]

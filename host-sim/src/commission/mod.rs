@@ -7,7 +7,9 @@
 
 pub mod margins;
 
-use crate::cli::{print_stdout, write_json, CliError, CommissionArgs};
+use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::values::positive_f64;
+use clap::Args;
 use closed_loop::commissioning::{commission, nameplate_config};
 use firmware::commissioning::CommissioningResult;
 use margins::{current_loop, margins, speed_loop, Margins, SpeedPlant};
@@ -15,6 +17,18 @@ use plant_model::Rig;
 use serde_json::json;
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// `eha commission`.
+#[derive(Debug, Args)]
+pub struct CommissionArgs {
+    /// Current-loop bandwidth to design for. [rad/s]
+    #[arg(long, value_name = "RAD_S", default_value = "1100", value_parser = positive_f64)]
+    pub bandwidth: f64,
+    /// Write the results as JSON (`-`: standard output).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
 
 /// Seed of the sensor noise (a fixed seed: the same rig gives the same report).
 pub const SEED: u64 = 1;
@@ -266,7 +280,7 @@ pub fn run_commission(rig: &Rig, args: &CommissionArgs) -> Result<(), CliError> 
     );
     if let Some(path) = &args.json {
         write_json(path, &report.to_json())?;
-        if crate::cli::is_stdout(path) {
+        if is_stdout(path) {
             return Ok(());
         }
     }

@@ -2,8 +2,24 @@
 //! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
 use super::analysis::analyse;
-use crate::cli::{print_stdout, write_json, CliError, DiagnoseArgs};
+use crate::output::{print_stdout, write_json, CliError};
+use clap::Args;
 use plant_model::Rig;
+use std::path::PathBuf;
+
+/// `eha diagnose`.
+#[derive(Debug, Args)]
+pub struct DiagnoseArgs {
+    /// Bench log to explain.
+    #[arg(value_name = "LOG.csv")]
+    pub log: PathBuf,
+    /// Write the results as JSON (`-`: standard output).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+    /// Folder for the report (plots and text).
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+}
 
 /// `eha diagnose`.
 pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {

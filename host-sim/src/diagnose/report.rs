@@ -7,7 +7,7 @@
 
 use super::analysis::Analysis;
 use super::predict::Predictor;
-use crate::cli::CliError;
+use crate::output::CliError;
 use crate::plots::{line_chart, Marker, Series};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -220,7 +220,7 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
         let _ = writeln!(md, "![{s} residual spectrum]({file})\n");
         files.push(file);
     }
-    crate::atomic_file::write(&dir.join("report.md"), md.as_bytes())
+    crate::output::atomic::write(&dir.join("report.md"), md.as_bytes())
         .map_err(|e| failed("report.md", e))?;
     files.push("report.md".into());
     Ok(files)
