@@ -252,8 +252,21 @@ impl fmt::Display for ParseError {
             ParseError::NoTag => write!(f, "no `{LINE_TAG} ` tag in the line"),
             ParseError::Missing(k) => write!(f, "field `{k}` missing or out of order"),
             ParseError::BadValue(k) => write!(f, "field `{k}` is not a number"),
-            ParseError::BadMode => write!(f, "field `mode` is not a mode code (0..=3)"),
-            ParseError::BadFault => write!(f, "field `fault` is not a fault code (0..=12)"),
+            ParseError::BadMode => {
+                let last = (0..=u8::MAX)
+                    .take_while(|c| Mode::from_code(*c).is_some())
+                    .last()
+                    .unwrap_or(0);
+                write!(f, "field `mode` is not a mode code (0..={last})")
+            }
+            ParseError::BadFault => {
+                // 0 is "no fault"; the codes are the supervisor's enumeration.
+                let last = FaultCode::ALL.iter().map(|c| c.code()).max().unwrap_or(0);
+                write!(
+                    f,
+                    "field `fault` is not a fault code (0, none, or 1..={last})"
+                )
+            }
         }
     }
 }
@@ -362,6 +375,32 @@ mod tests {
             Err(ParseError::Missing("p_ref_pa"))
         );
         assert_eq!(parse_line("EHA1 t_s=x"), Err(ParseError::BadValue("t_s")));
+    }
+
+    #[test]
+    fn the_fault_code_message_spans_every_code_the_parser_accepts() {
+        // The codes the parser accepts, found by trying each byte, not from the message.
+        let line = |code: u8| {
+            let mut s = String::new();
+            frame().write_line(&mut s).unwrap();
+            let cut = s.find(" fault=").unwrap();
+            let rest = &s[cut + " fault=".len()..];
+            let after = rest.find(' ').unwrap();
+            format!("{} fault={code}{}", &s[..cut], &rest[after..])
+        };
+        let accepted: Vec<u8> = (0..=u8::MAX)
+            .filter(|c| parse_line(&line(*c)).is_ok())
+            .collect();
+        let last = *accepted.last().unwrap();
+        assert_eq!(
+            accepted,
+            (0..=last).collect::<Vec<u8>>(),
+            "contiguous from 0"
+        );
+        assert!(last >= 16, "the supervisor has at least 16 fault codes");
+        assert_eq!(parse_line(&line(last + 1)), Err(ParseError::BadFault));
+        let msg = format!("{}", ParseError::BadFault);
+        assert!(msg.contains(&format!("1..={last}")), "{msg}");
     }
 
     #[test]
