@@ -10,7 +10,8 @@
 use crate::commission::CommissionArgs;
 use crate::diagnose::command::DiagnoseArgs;
 use crate::ingest::IngestArgs;
-use crate::output::CliError;
+use crate::output::paths::{self, Declared};
+use crate::output::{interrupt, CliError};
 use crate::rig_file::{self, RigArgs};
 use crate::simulate::demo::DemoArgs;
 use crate::simulate::SimulateArgs;
@@ -61,12 +62,19 @@ pub enum Command {
 
 /// Parses the process's arguments, runs, reports; the binary's whole `main`.
 pub fn main() -> ExitCode {
+    interrupt::install();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
             // Usage errors go to stderr with status 2; --help and --version to stdout, 0.
-            let _ = e.print();
-            return ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
+            let code = ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
+            if e.use_stderr() {
+                let text = crate::values::shorten_long_words(&e.render().to_string());
+                let _ = write!(io::stderr(), "{text}");
+            } else {
+                let _ = e.print();
+            }
+            return code;
         }
     };
     match run(cli) {
@@ -78,8 +86,27 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// Runs a parsed command line.
+impl Command {
+    /// The files the subcommand reads and writes.
+    pub fn paths(&self) -> Declared<'_> {
+        match self {
+            Command::Rig(a) => a.paths(),
+            Command::Demo(a) => a.paths(),
+            Command::Simulate(a) => a.paths(),
+            Command::SweepPrecharge(a) => a.paths(),
+            Command::AccumulatorDesign(a) => a.paths(),
+            Command::Commission(a) => a.paths(),
+            Command::Tune(a) => a.paths(),
+            Command::Ingest(a) => a.paths(),
+            Command::Diagnose(a) => a.paths(),
+        }
+    }
+}
+
+/// Runs a parsed command line: every path checked first, then the rig loaded, then the
+/// subcommand.
 pub fn run(cli: Cli) -> Result<(), CliError> {
+    paths::check(&cli.command.paths().input("--rig", cli.rig.as_ref()))?;
     let rig = match &cli.rig {
         Some(path) => rig_file::load(path)?,
         None => Rig::nominal(),

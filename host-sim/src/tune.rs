@@ -17,6 +17,7 @@
 pub mod can;
 pub mod candidates;
 pub mod fit;
+pub mod glitch;
 pub mod predict;
 pub mod pressure;
 pub mod report;
@@ -24,8 +25,9 @@ pub mod speed;
 pub mod step;
 
 use crate::bench_log::BenchLog;
+use crate::output::paths::Declared;
 use crate::output::{is_stdout, print_stdout, write_json, CliError};
-use crate::values::{non_negative_f64, positive_f64};
+use crate::values::{non_negative_f64, positive_f64, show};
 use can::Setting;
 use clap::{Args, ValueEnum};
 use closed_loop::controller_config;
@@ -55,14 +57,23 @@ pub struct TuneArgs {
     #[arg(long = "loop", value_enum)]
     pub loop_kind: LoopKind,
     /// Overshoot target. [%]
-    #[arg(long, value_name = "PCT", value_parser = non_negative_f64)]
+    #[arg(long, value_name = "PCT", value_parser = non_negative_f64, allow_negative_numbers = true)]
     pub overshoot: Option<f64>,
     /// Settling-time target. [s]
-    #[arg(long, value_name = "S", value_parser = positive_f64)]
+    #[arg(long, value_name = "S", value_parser = positive_f64, allow_negative_numbers = true)]
     pub settling: Option<f64>,
     /// Write the results as JSON (`-`: standard output).
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+}
+
+impl TuneArgs {
+    /// The files it reads and writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default()
+            .input("LOG", Some(&self.log))
+            .file("--json", self.json.as_ref())
+    }
 }
 
 /// Default target of the speed loop: what its documented design (Table 1 gains, poles at
@@ -194,9 +205,11 @@ pub fn tune(
     target: Target,
 ) -> Result<Tuning, TuneError> {
     let config = controller_config(rig);
-    config
-        .validate()
-        .map_err(|e| TuneError::BadLog(format!("the rig's controller configuration: {e:?}")))?;
+    config.validate().map_err(|e| {
+        TuneError::BadLog(format!(
+            "the rig gives a controller configuration the firmware refuses: {e}"
+        ))
+    })?;
     let (signal, reference, response) = match kind {
         LoopKind::Speed => {
             let r = log.speed_ref_rad_s.as_deref().ok_or_else(|| {
@@ -217,6 +230,23 @@ pub fn tune(
              {:.0} rad/s, at the {limit:.0} rad/s limit (a saturated pressure loop, not a \
              speed setpoint)",
             step.from, step.to
+        )));
+    }
+    // A lone sample leaving both neighbours by half the step is no response of the loop.
+    if let Some(k) = glitch::lone_spike(response, 0.5 * (step.to - step.from).abs()) {
+        let (column, unit, scale) = match kind {
+            LoopKind::Speed => ("speed_rad_s", "rad/s", 1.0),
+            LoopKind::Pressure => ("p_pa", "MPa", 1e-6),
+        };
+        return Err(TuneError::BadLog(format!(
+            "the log's {column} at t = {:.4} s (data row {}) reads {:.4} {unit} between {:.4} and \
+             {:.4} {unit}: a dropped or corrupted sample, which would bias the identification; \
+             repair or remove that row",
+            log.t_s[k],
+            k + 1,
+            response[k] * scale,
+            response[k - 1] * scale,
+            response[k + 1] * scale
         )));
     }
     let measured = step::metrics(&log.t_s, response, &step, signal);
@@ -342,6 +372,7 @@ fn no_step(kind: LoopKind, e: StepError) -> TuneError {
 fn tune_speed(job: &Job) -> Result<LoopTuning, TuneError> {
     let (rig, config, log, step, target) = (job.rig, job.config, job.log, job.step, job.target);
     let shaft = speed::identify(rig, log, &step).map_err(TuneError::BadLog)?;
+    simulatable(&speed::identified_rig(rig, &shaft), "speed response")?;
     let spec = replay_spec(Signal::Speed, log, &step, log.p_pa[0], &target);
     let proposal =
         speed::propose(rig, config, &shaft, &spec, &target).map_err(TuneError::Failed)?;
@@ -357,6 +388,7 @@ fn tune_speed(job: &Job) -> Result<LoopTuning, TuneError> {
 fn tune_pressure(job: &Job) -> Result<LoopTuning, TuneError> {
     let (rig, config, log, step, target) = (job.rig, job.config, job.log, job.step, job.target);
     let high = pressure::identify(rig, log).map_err(TuneError::BadLog)?;
+    simulatable(&pressure::identified_rig(rig, &high), "pressure response")?;
     let p_start = log.p_pa[step.start.saturating_sub(1)];
     let spec = replay_spec(Signal::Pressure, log, &step, p_start, &target);
     let proposal =
@@ -374,6 +406,18 @@ fn tune_pressure(job: &Job) -> Result<LoopTuning, TuneError> {
     };
     let plant = pressure::identified_rig(rig, &high);
     finish(spec, identified, proposal, &plant, config)
+}
+
+/// Checks that the plant identified from the log's `what` can be simulated: a log whose
+/// response no plant of this kind produces (a sensor scaled wrongly, data of another
+/// machine) is bad input, said before any proposal is attempted.
+fn simulatable(plant: &Rig, what: &str) -> Result<(), TuneError> {
+    plant.validate().map_err(|e| {
+        TuneError::BadLog(format!(
+            "the log's {what} identifies a plant that cannot be simulated ({e}): is the log \
+             of this rig, its units SI?"
+        ))
+    })
 }
 
 /// The replay of the log's step: the scenarios' lead time at the initial setpoint (0.1 s
@@ -412,8 +456,44 @@ fn finish(
     Ok((spec, identified, proposal, replayed.metrics))
 }
 
+/// The longest settling target per loop: the step is replayed for twice the target on
+/// each candidate design, so the target bounds the run time (a few seconds at these
+/// limits); no tuning of this drive asks for slower loops. [s]
+pub const MAX_SETTLING_S: [(LoopKind, f64); 2] =
+    [(LoopKind::Speed, 2.0), (LoopKind::Pressure, 10.0)];
+
+/// The shortest settling target: a millisecond is ten periods of the fastest outer loop. [s]
+pub const MIN_SETTLING_S: f64 = 1e-3;
+
+/// Checks the command line's target before the log is read.
+fn check_target(args: &TuneArgs) -> Result<(), CliError> {
+    if let Some(o) = args.overshoot.filter(|o| *o > 100.0) {
+        return Err(CliError::BadInput(format!(
+            "--overshoot {} %: an overshoot target lies between 0 and 100 %",
+            show(o)
+        )));
+    }
+    let most = MAX_SETTLING_S
+        .iter()
+        .find(|(k, _)| *k == args.loop_kind)
+        .map_or(10.0, |(_, s)| *s);
+    if let Some(s) = args
+        .settling
+        .filter(|s| !(MIN_SETTLING_S..=most).contains(s))
+    {
+        return Err(CliError::BadInput(format!(
+            "--settling {} s: the {} loop's settling target lies between {MIN_SETTLING_S} and \
+             {most} s",
+            show(s),
+            report::loop_name(args.loop_kind)
+        )));
+    }
+    Ok(())
+}
+
 /// `eha tune`.
 pub fn run_tune(rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
+    check_target(args)?;
     let log = crate::bench_log::read(&args.log)?;
     let target = target_for(args.loop_kind, args.overshoot, args.settling);
     let t = tune(rig, &log, args.loop_kind, target)?;

@@ -40,7 +40,8 @@ pub fn write_report(dir: &Path, log_path: &Path, analysis: &Analysis) -> Result<
         .map_or("report".into(), |n| n.to_string_lossy().to_string());
     let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&staging);
-    std::fs::create_dir_all(&staging).map_err(|e| failed(&staging.display().to_string(), e))?;
+    std::fs::create_dir_all(&staging).map_err(|e| failed(&dir.display().to_string(), e))?;
+    let _cleanup = crate::output::interrupt::remove_on_interrupt(&staging);
     let result = render(&staging, log_path, analysis).and_then(|files| {
         std::fs::create_dir_all(dir).map_err(|e| failed(&dir.display().to_string(), e))?;
         for f in files {

@@ -1,12 +1,16 @@
 //! What every subcommand reports through: the error type [`CliError`] with its exit status,
 //! standard output that tolerates a closed pipe ([`print_stdout`]), JSON documents written
 //! to a file or standard output ([`write_json`]), and output files that appear whole or not
-//! at all ([`atomic`]).
+//! at all ([`atomic`]); the paths a subcommand is given, checked before it runs
+//! ([`paths`]); and clean-up when a run is interrupted ([`interrupt`]).
 //!
 //! Exit status: 0 on success, 2 for bad input or arguments (a bad rig file, a bad bench
 //! log, a value out of range), 1 for anything else; the message goes to standard error.
 
 pub mod atomic;
+pub mod interrupt;
+pub mod paths;
+pub mod progress;
 
 use crate::bench_log::BenchLogError;
 use crate::rig_file::RigFileError;
@@ -79,4 +83,13 @@ pub fn print_stdout(text: &str) -> Result<(), CliError> {
         }),
         _ => Ok(()),
     }
+}
+
+/// A fresh, empty scratch folder `eha-<name>-<pid>` for a unit test.
+#[cfg(test)]
+pub(crate) fn scratch_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("eha-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
 }

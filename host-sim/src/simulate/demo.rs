@@ -3,7 +3,8 @@
 //! SVG plots in an output folder.
 
 use super::holding::pulsation;
-use super::{effects_text, plant_rig, rig_name, write_log, LOG_RATE_HZ};
+use super::{converged, effects_text, plant_rig, rig_name, write_log, LOG_RATE_HZ};
+use crate::output::paths::Declared;
 use crate::output::{print_stdout, CliError};
 use crate::plots::{line_chart, Marker, Series};
 use crate::pulsation::sources;
@@ -22,6 +23,13 @@ pub struct DemoArgs {
     /// Output folder for plots and the bench log.
     #[arg(long, value_name = "DIR", default_value = "eha-out")]
     pub out: PathBuf,
+}
+
+impl DemoArgs {
+    /// The files it writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default().dir("--out", Some(&self.out))
+    }
 }
 
 /// A demo run: plant rig, controller rig, scenario, duration [s], log metadata.
@@ -98,6 +106,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         runs.next()
             .unwrap_or_else(|| Err("run missing".into()))
             .map_err(CliError::Failed)
+            .and_then(converged)
     };
     let (with, without, stepped, sped) = (next()?, next()?, next()?, next()?);
     let pw = pulsation(&with, hold, &plant);

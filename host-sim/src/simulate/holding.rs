@@ -72,4 +72,5 @@ pub(crate) fn holding_run(
         },
     )
     .map_err(CliError::Failed)
+    .and_then(super::converged)
 }

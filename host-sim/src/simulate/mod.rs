@@ -5,11 +5,13 @@
 pub mod demo;
 pub mod holding;
 
-use crate::bench_log::{self, BenchLog};
+use crate::bench_log::limits::MAX_ROWS;
+use crate::bench_log::{self, BenchLog, MIN_ROWS};
+use crate::output::paths::Declared;
 use crate::output::{print_stdout, write_json, CliError};
 use crate::rig_file;
-use crate::run::{run, RunOptions};
-use crate::values::positive_f64;
+use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
+use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::{by_name, SCENARIOS};
 use plant_model::effects::EFFECT_NAMES;
@@ -31,7 +33,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "LOG.csv", required_unless_present = "list")]
     pub out: Option<PathBuf>,
     /// Absorber precharge (gauge), replacing the rig's. [Pa]
-    #[arg(long, value_name = "PA", value_parser = positive_f64)]
+    #[arg(long, value_name = "PA", value_parser = positive_f64, allow_negative_numbers = true)]
     pub precharge: Option<f64>,
     /// Rig file of the simulated actuator when it is not the one the controller is
     /// configured from (`--rig`, `--precharge`): a bench whose absorber or shaft differs
@@ -39,7 +41,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "FILE")]
     pub plant_rig: Option<PathBuf>,
     /// Simulated duration, replacing the scenario's. [s]
-    #[arg(long, value_name = "S", value_parser = positive_f64)]
+    #[arg(long, value_name = "S", value_parser = positive_f64, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Effects to switch on: names from effects.md, each optionally with parameters,
     /// e.g. `piston_ripple,cogging_torque:amplitude_nm=0.05,order=72`.
@@ -50,7 +52,7 @@ pub struct SimulateArgs {
     pub seed: Option<u64>,
     /// Log rate (a divisor of the 20 kHz PWM rate is logged exactly; typical bench logs
     /// are 1 kHz). [Hz]
-    #[arg(long, value_name = "HZ", default_value = "2000", value_parser = log_rate)]
+    #[arg(long, value_name = "HZ", default_value = "2000", value_parser = log_rate, allow_negative_numbers = true)]
     pub log_rate: f64,
     /// Name the scenarios and exit.
     #[arg(long)]
@@ -67,6 +69,16 @@ fn log_rate(s: &str) -> Result<f64, String> {
         return Err(format!("{v} Hz is above the 20000 Hz telemetry rate"));
     }
     Ok(v)
+}
+
+impl SimulateArgs {
+    /// The files it reads and writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default()
+            .input("--plant-rig", self.plant_rig.as_ref())
+            .file("--out", self.out.as_ref())
+            .file("--json", self.json.as_ref())
+    }
 }
 
 /// The parsed `--effects` list.
@@ -146,6 +158,44 @@ pub(crate) fn plant_rig(rig: &Rig, effects: &[Effect]) -> Result<Rig, CliError> 
     Ok(r)
 }
 
+/// `run` unless its state left the physical range: a rig the integration cannot follow
+/// (bad input, exit status 2) rather than a log of NaN.
+pub(crate) fn converged(run: Run) -> Result<Run, CliError> {
+    match first_unphysical(&run.log) {
+        None => Ok(run),
+        Some((t, name, v)) => Err(CliError::BadInput(format!(
+            "the simulation diverged: `{name}` reached {v:e} at t = {t:.6} s; the rig's \
+             parameters make the model numerically unstable (check the rig file's values)"
+        ))),
+    }
+}
+
+/// Checks before a run that `duration_s` [s] at `log_rate_hz` [Hz] gives a bench log of
+/// [`MIN_ROWS`] to [`MAX_ROWS`] rows (`period_s`: the PWM period [s]).
+fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<(), CliError> {
+    let (every, rows) = log_plan(duration_s, log_rate_hz, period_s);
+    let rate = 1.0 / (period_s * every as f64);
+    let asked = format!(
+        "--duration {} s at --log-rate {} Hz",
+        show(duration_s),
+        show(log_rate_hz)
+    );
+    if rows > MAX_ROWS as f64 {
+        return Err(CliError::BadInput(format!(
+            "{asked} would log {} rows; a bench log holds at most {MAX_ROWS} ({:.0} s at this \
+             rate)",
+            show(rows),
+            MAX_ROWS as f64 / rate
+        )));
+    }
+    if rows < MIN_ROWS as f64 {
+        return Err(CliError::BadInput(format!(
+            "{asked} would log {rows} rows; a bench log needs at least {MIN_ROWS}"
+        )));
+    }
+    Ok(())
+}
+
 pub(crate) fn write_log(path: &Path, log: &BenchLog) -> Result<(), CliError> {
     bench_log::write(path, log)?;
     Ok(())
@@ -180,9 +230,14 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     if let Some(p0) = args.precharge {
         controller.absorber.precharge_pa = p0;
     }
-    controller
-        .validate()
-        .map_err(|e| CliError::BadInput(format!("{e}")))?;
+    controller.validate().map_err(|e| {
+        CliError::BadInput(match args.precharge {
+            Some(p0) if e.parameter == "absorber.precharge_pa" => {
+                format!("--precharge {}: {e}", show(p0))
+            }
+            _ => e.to_string(),
+        })
+    })?;
     let effects = args
         .effects
         .as_ref()
@@ -194,6 +249,8 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         None => plant_rig(&controller, &effects)?,
     };
     let duration = args.duration.unwrap_or(scenario.duration_s);
+    let period_s = 1.0 / closed_loop::controller_config(&controller).rates.pwm_hz as f64;
+    check_log_length(duration, args.log_rate, period_s)?;
     let seed = args.seed.unwrap_or(1);
     let mut metadata = vec![
         ("source".into(), "simulation".into()),
@@ -221,7 +278,8 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             metadata,
         },
     )
-    .map_err(CliError::Failed)?;
+    .map_err(CliError::Failed)
+    .and_then(converged)?;
     write_log(out, &r.log)?;
     eprintln!(
         "{}: {} rows over {duration} s written to {} ({:.0}× real time)",

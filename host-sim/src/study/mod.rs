@@ -5,6 +5,7 @@
 pub mod accumulator_design;
 pub mod precharge_sweep;
 
+use crate::output::paths::Declared;
 use crate::output::{is_stdout, print_stdout, write_json, CliError};
 use crate::values::positive_f64;
 use clap::Args;
@@ -18,8 +19,15 @@ pub struct AccumulatorDesignArgs {
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
     /// Working (holding) pressure, gauge: the paper's low-speed pressure-holding case. [Pa]
-    #[arg(long, value_name = "PA", default_value = "5e6", value_parser = positive_f64)]
+    #[arg(long, value_name = "PA", default_value = "5e6", value_parser = positive_f64, allow_negative_numbers = true)]
     pub pressure: f64,
+}
+
+impl AccumulatorDesignArgs {
+    /// The files it writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default().file("--json", self.json.as_ref())
+    }
 }
 
 /// `eha accumulator-design`: a table on standard output, JSON with `--json`.

@@ -3,12 +3,13 @@
 //! steady pulsation of each against the reference, with the absorber's natural frequency
 //! and damping at the run's mean pressure; optionally the runs' bench logs and plots.
 
+use crate::output::paths::Declared;
 use crate::output::{is_stdout, print_stdout, write_json, CliError};
 use crate::plots::{line_chart, Series};
 use crate::run::Run;
 use crate::simulate::holding::{holding_run, pulsation, Pulsation};
 use crate::simulate::{effects_text, plant_rig, write_log};
-use crate::values::positive_f64;
+use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::by_name;
 use plant_model::effects::paper_low_speed_effects;
@@ -27,7 +28,7 @@ pub struct SweepPrechargeArgs {
         value_name = "PA,PA,…",
         value_delimiter = ',',
         default_value = "2e6,4e6,5e6,10e6,13e6",
-        value_parser = positive_f64
+        value_parser = positive_f64, allow_negative_numbers = true
     )]
     pub values: Vec<f64>,
     /// Write the results as JSON (`-`: standard output).
@@ -36,6 +37,35 @@ pub struct SweepPrechargeArgs {
     /// Folder for plots and the runs' bench logs.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+}
+
+impl SweepPrechargeArgs {
+    /// The files it writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default()
+            .file("--json", self.json.as_ref())
+            .dir("--out", self.out.as_ref())
+    }
+}
+
+/// Most precharges one sweep runs.
+pub const MAX_POINTS: usize = 32;
+
+/// Decimals of the MPa in the runs' file names: one, or as many as keep every name apart
+/// (5.00 and 5.04 MPa would both be `precharge-5.0MPa.csv`).
+fn file_decimals(values: impl Iterator<Item = f64> + Clone) -> usize {
+    (1..=12)
+        .find(|&d| {
+            let names: Vec<String> = values
+                .clone()
+                .map(|v| format!("{:.*}", d, v / 1e6))
+                .collect();
+            names
+                .iter()
+                .enumerate()
+                .all(|(i, n)| !names[..i].contains(n))
+        })
+        .unwrap_or(12)
 }
 
 /// A sweep result: precharge (None for the reference without absorber), run, figures.
@@ -47,6 +77,21 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
         return Err(CliError::BadInput(
             "--values needs at least one precharge".into(),
         ));
+    }
+    if args.values.len() > MAX_POINTS {
+        return Err(CliError::BadInput(format!(
+            "--values names {} precharges; a sweep runs at most {MAX_POINTS} (each is a 4 s \
+             closed-loop run)",
+            args.values.len()
+        )));
+    }
+    for (i, v) in args.values.iter().enumerate() {
+        if args.values[..i].contains(v) {
+            return Err(CliError::BadInput(format!(
+                "--values names the precharge {} Pa twice",
+                show(*v)
+            )));
+        }
     }
     let effects: Vec<Effect> = paper_low_speed_effects().to_vec();
     let hold =
@@ -64,7 +109,7 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
         controller.absorber.precharge_pa = p0;
         controller
             .validate()
-            .map_err(|e| CliError::BadInput(format!("precharge {p0} Pa: {e}")))?;
+            .map_err(|e| CliError::BadInput(format!("--values: precharge {} Pa: {e}", show(p0))))?;
         let plant = plant_rig(&controller, &effects)?;
         jobs.push((Some(p0), plant, controller));
     }
@@ -170,13 +215,14 @@ fn write_sweep_outputs(
         name: "no absorber",
         points: window(reference),
     }];
+    let decimals = file_decimals(points.iter().map(|(p0, _, _)| *p0));
     let names: Vec<String> = points
         .iter()
         .map(|(p0, _, _)| format!("p0 = {:.1} MPa", p0 / 1e6))
         .collect();
     for ((p0, run, _), name) in points.iter().zip(&names) {
         write_log(
-            &dir.join(format!("precharge-{:.1}MPa.csv", p0 / 1e6)),
+            &dir.join(format!("precharge-{:.*}MPa.csv", decimals, p0 / 1e6)),
             &run.log,
         )?;
         traces.push(Series {

@@ -189,7 +189,8 @@ impl Tuning {
     }
 }
 
-fn loop_name(kind: LoopKind) -> &'static str {
+/// The loop's name in the JSON and the text.
+pub fn loop_name(kind: LoopKind) -> &'static str {
     match kind {
         LoopKind::Speed => "speed",
         LoopKind::Pressure => "pressure",
