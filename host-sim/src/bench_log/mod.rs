@@ -692,6 +692,20 @@ pub fn write(path: &Path, log: &BenchLog) -> Result<(), BenchLogError> {
     })
 }
 
+/// `log` as the bytes [`write`] puts in a file, after the same checks.
+pub fn to_bytes(log: &BenchLog) -> Result<Vec<u8>, BenchLogError> {
+    log.check(Path::new(IN_MEMORY))?;
+    let mut out = Vec::new();
+    write_to(&mut out, log).map_err(|source| BenchLogError::Write {
+        file: PathBuf::from(IN_MEMORY),
+        source,
+    })?;
+    Ok(out)
+}
+
+/// What errors about a log held in memory name as its file.
+const IN_MEMORY: &str = "<in memory>";
+
 /// Writes `log` (assumed checked) to `w`.
 fn write_to(w: &mut dyn Write, log: &BenchLog) -> io::Result<()> {
     for (k, v) in &log.metadata {
