@@ -496,7 +496,14 @@ pub fn run_tune(rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
     check_target(args)?;
     let log = crate::bench_log::read(&args.log)?;
     let target = target_for(args.loop_kind, args.overshoot, args.settling);
-    let t = tune(rig, &log, args.loop_kind, target)?;
+    let busy = crate::output::progress::spinner(format!(
+        "tuning the {} loop from {}",
+        report::loop_name(args.loop_kind),
+        args.log.display()
+    ));
+    let t = tune(rig, &log, args.loop_kind, target);
+    busy.finish_and_clear();
+    let t = t?;
     let commands = can::command_lines(&t.settings).map_err(CliError::Failed)?;
     if let Some(path) = &args.json {
         write_json(path, &t.to_json(&commands))?;

@@ -69,8 +69,9 @@ pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
         args.log.display(),
         log.len()
     ));
-    let analysis = analyse(&log, rig).map_err(|e| input_or_failure(e, &args.log))?;
+    let analysis = analyse(&log, rig);
     busy.finish_and_clear();
+    let analysis = analysis.map_err(|e| input_or_failure(e, &args.log))?;
     let d = &analysis.diagnosis;
     let mut text = String::new();
     text.push_str(&format!(
