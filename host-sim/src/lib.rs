@@ -14,6 +14,7 @@
 //! - [`commission`], [`tune`]: commissioning on the simulated motor and loop tuning from a
 //!   step log.
 //! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain.
+//! - [`watch`]: the drive's telemetry live in the terminal, and the bench log as it comes.
 
 pub mod bench_log;
 pub mod cli;
@@ -29,3 +30,4 @@ pub mod simulate;
 pub mod study;
 pub mod tune;
 pub mod values;
+pub mod watch;
