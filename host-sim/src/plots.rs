@@ -1,4 +1,5 @@
-//! SVG plots (plotters): time traces, spectra with the physical orders marked, sweep curves.
+//! SVG plots (plotters): time traces, spectra with the physical orders marked, sweep curves,
+//! each written atomically.
 //!
 //! Points that are not finite are left out, and the axes span at most [`MAX_SPAN`]: a
 //! range beyond it (values near ±1e308, whose difference overflows) would leave plotters'
@@ -91,7 +92,10 @@ pub fn line_chart(
             y1 - y0
         )));
     }
-    let root = SVGBackend::new(path, (960, 540)).into_drawing_area();
+    // Drawn into memory, then written atomically: no half-written SVG, no special file
+    // replaced (see `crate::output::atomic`).
+    let mut svg = String::new();
+    let root = SVGBackend::with_string(&mut svg, (960, 540)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let mut builder = ChartBuilder::on(&root);
     builder
@@ -157,7 +161,9 @@ pub fn line_chart(
             .map_err(|e| err(&e))?);
     }
     root.present().map_err(|e| err(&e))?;
-    Ok(())
+    drop(root);
+    crate::output::atomic::write(path, svg.as_bytes())
+        .map_err(|e| err(&crate::output::paths::describe(&e)))
 }
 
 #[cfg(test)]
