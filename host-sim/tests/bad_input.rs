@@ -116,8 +116,25 @@ fn bad_paths_are_refused_before_the_run_and_leave_nothing() {
         .status()
         .unwrap()
         .success());
+    // Output folders holding a special file where the command would write one of its own.
+    let demo_out = dir.join("demo-out");
+    fs::create_dir(&demo_out).unwrap();
+    assert!(std::process::Command::new("mkfifo")
+        .arg(demo_out.join("speed_step.svg"))
+        .status()
+        .unwrap()
+        .success());
+    std::os::unix::fs::symlink("/dev/null", demo_out.join("sweep.svg")).unwrap();
     let before = entries(&dir);
     let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
+        (
+            vec!["demo", "--out", s(&demo_out)],
+            vec!["speed_step.svg", "FIFO"],
+        ),
+        (
+            vec!["sweep-precharge", "--values", "5e6", "--out", s(&demo_out)],
+            vec!["sweep.svg", "character device"],
+        ),
         // Inputs: missing, a folder, a device.
         (
             vec!["diagnose", s(&missing)],

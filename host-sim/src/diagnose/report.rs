@@ -115,7 +115,7 @@ pub fn write_report(dir: &Path, log_path: &Path, analysis: &Analysis) -> Result<
     let result = render(&staging, log_path, analysis).and_then(|files| {
         std::fs::create_dir_all(dir).map_err(|e| failed(&dir.display().to_string(), e))?;
         for f in files {
-            std::fs::rename(staging.join(&f), dir.join(&f))
+            crate::output::atomic::rename_into(&staging.join(&f), &dir.join(&f))
                 .map_err(|e| failed(&dir.join(&f).display().to_string(), e))?;
         }
         Ok(())

@@ -1,4 +1,4 @@
-//! Plots (plotters, SVG; a PNG beside each, [`png`]): time traces, spectra with the
+//! Plots (plotters, SVG written atomically; a PNG beside each, [`png`]): time traces, spectra with the
 //! physical orders marked, sweep curves, and figures of panels stacked over one time axis
 //! (a signal above, its residual or its measured reading beneath, each on its own scale).
 //!
@@ -216,8 +216,11 @@ pub fn stacked_chart(
             )));
         }
     }
+    // Drawn into memory, then written atomically (no half-written SVG, no special file
+    // replaced: `crate::output::atomic`), and the PNG rendered from the same text.
+    let mut svg = String::new();
     {
-        let root = SVGBackend::new(path, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
         let body = root
             .titled(title, ("sans-serif", 20))
@@ -238,7 +241,9 @@ pub fn stacked_chart(
         }
         root.present().map_err(|e| err(&e))?;
     }
-    png::render_beside(path).map_err(|e| err(&e))?;
+    crate::output::atomic::write(path, svg.as_bytes())
+        .map_err(|e| err(&crate::output::paths::describe(&e)))?;
+    png::render_beside(path, &svg).map_err(|e| err(&e))?;
     Ok(())
 }
 

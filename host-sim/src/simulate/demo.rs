@@ -4,7 +4,7 @@
 
 use super::holding::pulsation;
 use super::{converged, effects_text, plant_rig, rig_name, write_log, LOG_RATE_HZ};
-use crate::output::paths::Declared;
+use crate::output::paths::{replaceable, Declared};
 use crate::output::{print_stdout, CliError};
 use crate::plots::{line_chart, stacked_chart, Marker, Panel, Series};
 use crate::pulsation::sources;
@@ -32,12 +32,33 @@ impl DemoArgs {
     }
 }
 
+/// The files the demo writes into its folder (each figure an SVG and a PNG).
+const FILES: [&str; 12] = [
+    "pressure-hold.csv",
+    "pressure-hold-no-absorber.csv",
+    "pressure-step.csv",
+    "speed-step.csv",
+    "pressure_trace.svg",
+    "pulsation_spectrum.svg",
+    "pressure_step.svg",
+    "speed_step.svg",
+    "pressure_trace.png",
+    "pulsation_spectrum.png",
+    "pressure_step.png",
+    "speed_step.png",
+];
+
 /// A demo run: plant rig, controller rig, scenario, duration [s], log metadata.
 type Job<'a> = (&'a Rig, &'a Rig, &'a Scenario, f64, Vec<(String, String)>);
 
 /// `eha demo`.
 pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     let out = &args.out;
+    // Checked before the runs: every file is written atomically and never over a special
+    // file, but a refusal after minutes of work would leave the folder half updated.
+    for name in FILES {
+        replaceable("--out", &out.join(name))?;
+    }
     std::fs::create_dir_all(out).map_err(|source| CliError::Write {
         file: out.clone(),
         source,
