@@ -112,6 +112,7 @@ pub struct LineFit {
 }
 
 /// Fits `effect` to the windows `lines` (already restricted to the segment wanted).
+#[allow(clippy::too_many_arguments)]
 pub fn fit_line(
     effect: LineEffect,
     lines: &[&WindowLines],

@@ -409,6 +409,7 @@ pub struct MechanicalRelation<'a> {
     rig: &'a Rig,
     orders: Vec<u32>,
     /// The line bases of the windows seen so far, by their first and end rows.
+    #[allow(clippy::type_complexity)]
     bases: std::sync::Mutex<std::collections::HashMap<(usize, usize), Option<DMatrix<f64>>>>,
 }
 

@@ -40,7 +40,9 @@ pub fn threshold(dof: usize) -> f64 {
         .unwrap_or(f64::INFINITY)
 }
 
-/// Why a tested effect is not named, or `None` when it qualifies.
+/// Why a tested effect is not named, or `None` when it qualifies (a NaN statistic is not
+/// significant, hence the negated comparison).
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub fn why_not(t: &Tested) -> Option<String> {
     let limit = threshold(t.dof);
     if !(t.lambda > limit) {
