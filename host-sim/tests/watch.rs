@@ -16,7 +16,7 @@ use common::{s, scratch};
 use firmware::{FaultCode, Mode};
 use std::fs;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -192,7 +192,7 @@ fn entries(d: &Path) -> Vec<String> {
 }
 
 /// Checks that `log` holds the recording's frames, value for value.
-fn check_log_values(log: &PathBuf, frames: usize) {
+fn check_log_values(log: &Path, frames: usize) {
     let written = host_sim::bench_log::read(log).unwrap();
     assert_eq!(written.len(), frames);
     for (k, line) in telemetry().iter().enumerate().take(frames) {
