@@ -13,7 +13,9 @@
 //!    parameter pages), written to `target/firmware-size.json`;
 //! 6. the processor-in-the-loop run in QEMU ([`pil`]): the control core and the plant on
 //!    the Cortex-M4F, telemetry through defmt and `eha ingest`, compared with the host run,
-//!    instruction counts against `pil/budget.toml`, figures in `target/pil/report.json`.
+//!    instruction counts against `pil/budget.toml`, figures in `target/pil/report.json`;
+//!    the same telemetry piped into `eha watch` under tmux ([`watch_check`]): its screen
+//!    checked, its bench log equal to `eha ingest`'s.
 //!
 //! `cargo xtask fw-size` does step 5 alone, `cargo xtask pil` step 6, `cargo xtask can`
 //! step 4; `cargo xtask dbc [--node N] [--out FILE]` writes the DBC file.
@@ -27,6 +29,7 @@ mod can_check;
 mod dbc;
 mod pil;
 mod setup;
+mod watch_check;
 
 const TARGET: &str = "thumbv7em-none-eabihf";
 /// 96 KiB: an STM32G431xB (128 KiB) still holds the image and the parameter store's pages.
