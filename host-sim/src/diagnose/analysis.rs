@@ -12,11 +12,12 @@
 //!    extended model, scored on the validation segment.
 //! 7. Evidence for the report: residual signatures and order spectra of the baseline.
 
+use super::angle_locked::ShaftConstants;
 use super::calibration::{
     calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Relation,
     Release, HYDRAULIC_WINDOW_S,
 };
-use super::candidates::{test_lines, test_relation, Extension, ShaftConstants, Tested};
+use super::candidates::{test_lines, test_relation, Extension, Tested};
 use super::cylinder::CylinderRelation;
 use super::decision::{apply_vetoes, decide, threshold, why_not};
 use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};

@@ -1,6 +1,7 @@
 //! Calibration before accusation: each parity relation's parameters fitted to the log
-//! within the rig's tolerance bands (Gaussian priors, [`super::least_squares`]), and the
-//! same fit with one effect's parameter released to its physically plausible range.
+//! within the rig's tolerance bands (hard bounds, every combination within them equally
+//! likely, [`super::least_squares`]), and the same fit with one effect's parameter released
+//! to its physically plausible range.
 //!
 //! The bands, as fractions of the rig file's value (or absolute where the nominal is 0):
 //!
@@ -21,7 +22,8 @@
 //!
 //! With the cylinder blocked every volume of the hydraulic relation is relative to the pump
 //! displacement (scaling D and all volumes together leaves p(θ) unchanged): there the
-//! priors share the tolerance out; a moving piston's A·x is an absolute volume and fixes D.
+//! fit may settle anywhere along that direction within the bands; a moving piston's A·x is
+//! an absolute volume and fixes D.
 
 use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::facts::LogFacts;
@@ -373,6 +375,16 @@ pub trait Relation: Sync {
     fn specs(&self, release: Release) -> Vec<ParamSpec>;
     /// Robust residuals (noise units, [`huber`]) at search `values` over `rows`.
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64>;
+    /// The released parameter's index and the values a coarse grid tries before the
+    /// local search (the calibrated tolerances may have bent towards a wrong basin: a
+    /// precharge far off is half-mimicked by displacement and shell volume); `None` when
+    /// the relation does not offer `release`.
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)>;
+}
+
+/// `nominal` times each of `factors`.
+pub fn scaled(nominal: f64, factors: &[f64]) -> Vec<f64> {
+    factors.iter().map(|f| nominal * f).collect()
 }
 
 /// The hydraulic relation of a log.
@@ -390,6 +402,27 @@ impl Relation for HydraulicRelation<'_> {
         hydraulic_specs(self.rig, release)
     }
 
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        let n = HydraulicParams::nominal(self.rig);
+        let p0 = n.absorber.map_or(1e6, |g| g.precharge_pa);
+        Some(match release {
+            Release::Leakage => (
+                hyd::LEAKAGE,
+                scaled(n.leakage_m3_s_pa, &[1.0, 2.0, 4.0, 8.0, 16.0]),
+            ),
+            Release::BulkModulus => (
+                hyd::BETA,
+                scaled(n.bulk_modulus_pa, &[1.0, 0.6, 0.35, 0.2, 0.1]),
+            ),
+            Release::Precharge => (
+                hyd::PRECHARGE,
+                scaled(p0, &[0.3, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0]),
+            ),
+            Release::SensorLag => (hyd::LAG, vec![0.5e-3, 3e-3, 10e-3, 30e-3, 100e-3]),
+            _ => return None,
+        })
+    }
+
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
         hydraulic_residuals(
             self.log,
@@ -401,6 +434,9 @@ impl Relation for HydraulicRelation<'_> {
     }
 }
 
+/// A window's basis of the angle lines, or `None` when it has too few rows.
+type LineBasis = Option<DMatrix<f64>>;
+
 /// The mechanical relation of a log.
 pub struct MechanicalRelation<'a> {
     log: &'a BenchLog,
@@ -409,8 +445,7 @@ pub struct MechanicalRelation<'a> {
     rig: &'a Rig,
     orders: Vec<u32>,
     /// The line bases of the windows seen so far, by their first and end rows.
-    #[allow(clippy::type_complexity)]
-    bases: std::sync::Mutex<std::collections::HashMap<(usize, usize), Option<DMatrix<f64>>>>,
+    bases: std::sync::Mutex<std::collections::HashMap<(usize, usize), LineBasis>>,
 }
 
 impl<'a> MechanicalRelation<'a> {
@@ -448,6 +483,10 @@ impl<'a> MechanicalRelation<'a> {
 impl Relation for MechanicalRelation<'_> {
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         mechanical_specs(self.rig, release)
+    }
+
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        (release == Release::ShaftFriction).then(|| (mech::COULOMB, vec![0.02, 0.1, 0.3, 0.8]))
     }
 
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
@@ -537,13 +576,33 @@ pub fn test_release<R: Relation>(
     release: Release,
     base: &Calibration,
 ) -> ReleaseTest {
-    let first = fit_relation(
-        relation,
-        rows,
-        release,
-        base.scale,
-        Some(&base.fitted.values),
-    );
+    // The grid's best point along the released parameter, the others as calibrated.
+    let specs = relation.specs(release);
+    let objective_at = |v: &[f64], scale: f64| -> f64 {
+        let prior: f64 = specs
+            .iter()
+            .zip(v)
+            .filter_map(|(s, x)| s.prior.map(|(m, sd)| ((s.coordinate(*x) - m) / sd).powi(2)))
+            .sum();
+        weighed_sse(relation, v, rows, scale) + prior
+    };
+    let mut start = base.fitted.values.clone();
+    if let Some((k, grid)) = relation.released(release) {
+        let best = grid
+            .iter()
+            .map(|g| {
+                let mut v = start.clone();
+                v[k] = *g;
+                (objective_at(&v, base.scale), v)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((j, v)) = best {
+            if j < objective_at(&start, base.scale) {
+                start = v;
+            }
+        }
+    }
+    let first = fit_relation(relation, rows, release, base.scale, Some(&start));
     let scale =
         variance_per_independent_sample(&relation.residuals(&first.values, rows)).min(base.scale);
     let fitted = fit_relation(relation, rows, release, scale, Some(&first.values));
