@@ -13,8 +13,12 @@ use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
-/// Tools found on `PATH` by name, and the Debian package that has each.
-const TOOLS: [(&str, &str); 2] = [("qemu-system-arm", "qemu-system-arm"), ("tmux", "tmux")];
+/// Tools found on `PATH` by name, the argument that makes each print its version and exit
+/// successfully (QEMU refuses tmux's `-V`), and the Debian package that has each.
+const TOOLS: [(&str, &str, &str); 2] = [
+    ("qemu-system-arm", "--version", "qemu-system-arm"),
+    ("tmux", "-V", "tmux"),
+];
 
 fn found(program: &str, arg: &str) -> bool {
     Command::new(program)
@@ -47,8 +51,8 @@ fn apt_install(packages: &[&str]) -> Result<()> {
 pub fn tools() -> Result<()> {
     let missing: Vec<&str> = TOOLS
         .iter()
-        .filter(|(cmd, _)| !found(cmd, "-V"))
-        .map(|(_, pkg)| *pkg)
+        .filter(|(cmd, version, _)| !found(cmd, version))
+        .map(|(_, _, pkg)| *pkg)
         .collect();
     if !missing.is_empty() {
         apt_install(&missing)?;
