@@ -222,8 +222,36 @@ fn help_and_version_succeed() {
         "tune",
         "ingest",
         "diagnose",
+        "watch",
     ] {
         assert!(help.contains(c), "{c} missing from --help");
+    }
+}
+
+#[test]
+fn demo_writes_a_png_beside_every_svg_and_the_pressure_figure_apart_from_the_reading() {
+    let dir = scratch("demo-figures");
+    let o = eha(&["demo", "--out", s(&dir)]);
+    assert_eq!(status(&o), 0, "{}", stderr(&o));
+    let mut svgs = 0;
+    for e in fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "svg") {
+            svgs += 1;
+            let png = fs::read(p.with_extension("png")).expect("a PNG beside the SVG");
+            assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{}", p.display());
+        }
+    }
+    assert_eq!(svgs, 4);
+    // The true pressures on one scale, the transducer's reading on a panel of its own.
+    let svg = fs::read_to_string(dir.join("pressure_trace.svg")).unwrap();
+    for label in [
+        "true p - 5 MPa [kPa]",
+        "measured p - 5 MPa [kPa]",
+        "true, no absorber",
+        "true, absorber fitted",
+    ] {
+        assert!(svg.contains(label), "{label}");
     }
 }
 
@@ -413,11 +441,13 @@ fn accumulator_design_writes_json_file_and_prints_the_table() {
         assert!(v[key].is_number(), "{key}");
     }
     assert_eq!(fs::read_dir(&dir).unwrap().count(), 1, "no temporary left");
-    // An unwritable destination is a failure (1), not bad input.
+    // A destination in a folder that does not exist is a bad argument, found before the
+    // run (2), naming the folder.
     let o = eha(&[
         "accumulator-design",
         "--json",
         s(&dir.join("no/such/dir/x.json")),
     ]);
-    assert_eq!(status(&o), 1, "{}", stderr(&o));
+    assert_eq!(status(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("no/such/dir"), "{}", stderr(&o));
 }
