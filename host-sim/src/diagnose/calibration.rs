@@ -656,14 +656,25 @@ pub fn test_release<R: Relation>(
     let scale =
         variance_per_independent_sample(&relation.residuals(&first.values, rows)).min(base.scale);
     let fitted = reweighed(relation, rows, release, &first, base.scale, scale);
-    let baseline = reweighed(
-        relation,
-        rows,
-        Release::Nothing,
-        &base.fitted,
-        base.scale,
-        scale,
-    );
+    // The baseline: the calibration, or a fit within the bands from the released optimum
+    // brought into them, whichever is better. A baseline stopped short of its optimum
+    // would credit the released parameter with what any in-band change gains.
+    let in_band: Vec<f64> = relation
+        .specs(Release::Nothing)
+        .iter()
+        .zip(&first.values)
+        .map(|(s, v)| {
+            let (lo, hi) = s.u_bounds;
+            s.value(s.coordinate(*v).clamp(lo, hi))
+        })
+        .collect();
+    let again = fit_relation(relation, rows, Release::Nothing, base.scale, Some(&in_band));
+    let best = if again.data_sse < base.fitted.data_sse {
+        &again
+    } else {
+        &base.fitted
+    };
+    let baseline = reweighed(relation, rows, Release::Nothing, best, base.scale, scale);
     let objective = |f: &Fitted| f.data_sse + f.prior_sse;
     ReleaseTest {
         release,
