@@ -12,6 +12,7 @@
 use crate::bench_log::limits::{physical_range, MAX_ROWS};
 use crate::bench_log::BenchLog;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
+use firmware::config::Config;
 use indicatif::{ProgressBar, ProgressStyle};
 use plant_model::Rig;
 use std::time::{Duration, Instant};
@@ -81,9 +82,19 @@ pub fn run(
     scenario: &Scenario,
     opt: &RunOptions,
 ) -> Result<Run, String> {
-    let config = controller_config(controller_rig);
+    run_with_config(plant_rig, &controller_config(controller_rig), scenario, opt)
+}
+
+/// Runs `scenario` on the plant `plant_rig` under the controller configuration `config`
+/// (a tuned or otherwise non-default controller: other gains, another pressure loop).
+pub fn run_with_config(
+    plant_rig: &Rig,
+    config: &Config,
+    scenario: &Scenario,
+    opt: &RunOptions,
+) -> Result<Run, String> {
     let mut cl =
-        ClosedLoop::new(plant_rig, &config, scenario, opt.seed).map_err(|e| e.to_string())?;
+        ClosedLoop::new(plant_rig, config, scenario, opt.seed).map_err(|e| e.to_string())?;
     let (every, rows) = log_plan(opt.duration_s, opt.log_rate_hz, cl.period_s());
     if rows.is_nan() || rows > MAX_ROWS as f64 {
         return Err(format!(

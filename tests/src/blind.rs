@@ -14,15 +14,29 @@
 //! `speed_ref_rad_s`, as on a bench; every effect can be drawn with at least two scenarios
 //! and every scenario hosts several effects, so the commands do not give the effect away).
 //!
+//! Beyond the tolerances each draw varies structure ([`structure`]): the parts the rig
+//! contract leaves open, the controller's tuning, and the optional columns the bench logged
+//! (never one without which the hidden effect cannot be seen, [`needed_columns`]). The seeds
+//! of [`NOTHING_HIDDEN_SEEDS`] hide nothing: the false-alarm set.
+//!
 //! The ranges are physical, each justified where it is drawn ([`draw_effect`]); the
 //! signal of each (effect, scenario) pair is where its closed-loop signature stands
 //! furthest above the sensor noise ([`signal_for`]), measured with [`signature`].
 
-use closed_loop::{by_name, Scenario};
+mod observability;
+mod structure;
+
+pub use observability::{
+    angle_locked_fit_bound, line_below_noise, line_fit_bound, ripple_orders, signature, Signature,
+    LOGGED, RIPPLE_HARMONICS,
+};
+pub use structure::{ControllerVariant, Structure};
+
+use closed_loop::{by_name, controller_config, Scenario};
 use host_sim::bench_log::{self, BenchLog, Signal};
-use host_sim::run::{run, RunOptions};
+use host_sim::run::{run_with_config, RunOptions};
 use plant_model::effects::EFFECT_NAMES;
-use plant_model::pump::{kinematic_ripple_ratio, ripple_order};
+use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::{Effect, Rig};
 use rand_core::{RngCore, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -32,6 +46,10 @@ use std::path::{Path, PathBuf};
 /// Seeds of the suite: 0..36. The first 24 take effect `seed mod 12` (each of the 11
 /// effects and `none` twice), the rest draw the effect from the seed's stream.
 pub const SUITE_SEEDS: u64 = 36;
+
+/// Seeds of the false-alarm set: every one hides nothing, on a rig drawn like the others
+/// (tolerances, structure, controller, columns). Disjoint from `0..SUITE_SEEDS`.
+pub const NOTHING_HIDDEN_SEEDS: std::ops::Range<u64> = 1000..1020;
 
 /// Seeds below this take their effect from `seed mod 12` (full coverage, twice).
 const COVERED_SEEDS: u64 = 2 * EFFECT_NAMES.len() as u64;
@@ -65,8 +83,11 @@ pub struct Draw {
     pub truth: Truth,
     /// The hidden effect (with its parameters).
     pub effect: Effect,
-    /// The plant's rig: nominal ± tolerances, WITHOUT the effect.
+    /// The plant's rig: nominal ± tolerances with the drawn structure, WITHOUT the effect.
     pub tolerance_rig: Rig,
+    /// What was drawn beyond the tolerances: open parts of the rig, the controller's
+    /// tuning, the columns not logged (already in `tolerance_rig` where it is the rig's).
+    pub structure: Structure,
     /// The scenario, with its drawn length.
     pub scenario: Scenario,
     /// Sensor-noise seed of the plant.
@@ -330,14 +351,39 @@ pub const BELOW_NOISE: [&str; 1] = ["piston_ripple"];
 /// hold the diagnosis to them.
 pub const UNOBSERVABLE_PARAMETERS: [(&str, &str); 1] = [("shaft_friction", "static_nm")];
 
-/// The logged column where `effect` shows most in `scenario` (from the same table).
-pub fn signal_for(effect: &str, scenario: &str) -> Signal {
-    match (effect, scenario) {
-        ("piston_ripple" | "cogging_torque" | "flux_harmonics" | "shaft_friction", _) => Signal::Iq,
-        ("current_sensor_offset", _) => Signal::Iq,
-        ("dead_time", _) => Signal::Uq,
-        ("extra_leakage", _) => Signal::Speed,
+/// The logged column where `effect` shows most (from the same table): the q voltage for
+/// dead time when the voltages are logged, else the q current it disturbs.
+pub fn signal_for(effect: &str, voltages: bool) -> Signal {
+    match effect {
+        "piston_ripple" | "cogging_torque" | "flux_harmonics" | "shaft_friction" => Signal::Iq,
+        "current_sensor_offset" => Signal::Iq,
+        "dead_time" if voltages => Signal::Uq,
+        "dead_time" => Signal::Iq,
+        "extra_leakage" => Signal::Speed,
         _ => Signal::Pressure,
+    }
+}
+
+/// The optional columns without which `effect` cannot be seen in `scenario`: a moving
+/// piston's position for every effect of the pressure's volume balance and of the piston's
+/// force balance (without it the pump's largest flow is unknown), and the low side's
+/// pressure for the piston's friction. The generator never drops
+/// them for such a draw; the false-alarm set drops them freely.
+fn needed_columns(effect: &str, scenario: &Scenario) -> &'static [&'static str] {
+    let hydraulic = matches!(
+        effect,
+        "extra_leakage"
+            | "entrained_air"
+            | "accumulator_precharge"
+            | "pressure_sensor_lag"
+            | "cylinder_friction"
+    );
+    match (effect, scenario.blocked) {
+        // Along a one-way stroke the Coulomb force and an unknown fill pressure are the same
+        // constant pressure step: the low side must be logged to tell them apart.
+        ("cylinder_friction", false) => &["x_m", "p_low_pa"],
+        (_, false) if hydraulic => &["x_m"],
+        _ => &[],
     }
 }
 
@@ -345,24 +391,33 @@ pub fn signal_for(effect: &str, scenario: &str) -> Signal {
 pub fn draw(seed: u64) -> Draw {
     let mut s = Stream(Xoshiro256PlusPlus::seed_from_u64(seed));
     let n = EFFECT_NAMES.len() as u64;
-    let (effect_name, round) = if seed < COVERED_SEEDS {
+    let (effect_name, round) = if NOTHING_HIDDEN_SEEDS.contains(&seed) {
+        ("none", None)
+    } else if seed < COVERED_SEEDS {
         (EFFECT_NAMES[(seed % n) as usize], Some(seed / n))
     } else {
         (s.pick(&EFFECT_NAMES), None)
     };
-    let tolerance_rig = tolerance_rig(&mut s);
+    let mut tolerance_rig = tolerance_rig(&mut s);
     let effect = draw_effect(effect_name, &mut s, round);
     let scenario_name = s.pick(scenarios_for(effect_name));
     let mut scenario = *by_name(scenario_name).unwrap_or(&closed_loop::SCENARIOS[0]);
-    // Vary the length: the diagnosis must not rely on one log length. The pressure step
-    // only lengthens (its 4 s barely cover the fill of an absorber that lost its gas).
-    scenario.duration_s *= if scenario.name == "pressure-step" {
-        s.uniform(1.0, 1.25)
-    } else {
-        s.uniform(0.75, 1.0)
+    // Vary the length: the diagnosis must not rely on one log length; each scenario runs
+    // a few times its demonstration length, as a bench recording does (seconds of steady
+    // holding or running, not one second).
+    scenario.duration_s *= match scenario.name {
+        "speed-step" => s.uniform(3.0, 5.0),
+        "pressure-hold" => s.uniform(2.0, 3.5),
+        // Its 4 s barely cover the fill of an absorber that lost its gas, and the
+        // validation half must still see the fill's end.
+        "pressure-step" => s.uniform(1.0, 1.25),
+        _ => s.uniform(1.5, 2.0),
     };
     let noise_seed = s.0.next_u64();
     let token = s.0.next_u64();
+    let structure = structure::draw_structure(&mut s, needed_columns(effect_name, &scenario));
+    structure.apply(&mut tolerance_rig);
+    let voltages = !structure.dropped.contains(&"uq_v");
     let parameters = effect.parameters().into_iter().flatten().collect();
     Draw {
         truth: Truth {
@@ -370,19 +425,26 @@ pub fn draw(seed: u64) -> Draw {
             parameters,
             scenario: scenario.name,
             duration_s: scenario.duration_s,
-            signal: signal_for(effect_name, scenario.name).name(),
+            signal: signal_for(effect_name, voltages).name(),
         },
         effect,
         tolerance_rig,
+        structure,
         scenario,
         noise_seed,
         token,
     }
 }
 
-/// Runs `plant_rig` through `scenario` under the controller of the nominal rig, with sensor
-/// noise `noise_seed`, logged at [`LOG_RATE_HZ`]; the log's only metadata is its source.
-pub fn simulate(plant_rig: &Rig, scenario: &Scenario, noise_seed: u64) -> Result<BenchLog, String> {
+/// Runs `plant_rig` through `scenario` under the controller of the nominal rig tuned by
+/// `controller`, with sensor noise `noise_seed`, logged at [`LOG_RATE_HZ`]; the log's only
+/// metadata is its source.
+pub fn simulate(
+    plant_rig: &Rig,
+    controller: &ControllerVariant,
+    scenario: &Scenario,
+    noise_seed: u64,
+) -> Result<BenchLog, String> {
     let opt = RunOptions {
         duration_s: scenario.duration_s,
         log_rate_hz: LOG_RATE_HZ,
@@ -390,194 +452,23 @@ pub fn simulate(plant_rig: &Rig, scenario: &Scenario, noise_seed: u64) -> Result
         progress: false,
         metadata: vec![("source".into(), "blind-suite".into())],
     };
-    Ok(run(plant_rig, &Rig::nominal(), scenario, &opt)?.log)
+    let config = controller.apply(&controller_config(&Rig::nominal()));
+    Ok(run_with_config(plant_rig, &config, scenario, &opt)?.log)
 }
 
 /// Generates the log of `seed` into `dir`: returns its path and the truth.
 pub fn generate(seed: u64, dir: &Path) -> Result<(PathBuf, Truth), String> {
     let d = draw(seed);
-    let log = simulate(&d.truth_rig(), &d.scenario, d.noise_seed)?;
+    let mut log = simulate(
+        &d.truth_rig(),
+        &d.structure.controller,
+        &d.scenario,
+        d.noise_seed,
+    )?;
+    d.structure.drop_columns(&mut log);
     let path = dir.join(format!("blind-{:016x}.csv", d.token));
     bench_log::write(&path, &log).map_err(|e| e.to_string())?;
     Ok((path, d.truth))
-}
-
-/// `rig` with the white noise of every sensor off (quantisation stays).
-fn noise_free(rig: &Rig) -> Rig {
-    let mut r = rig.clone();
-    r.sensors.current.noise_a_rms = 0.0;
-    r.sensors.pressure.noise_pa_rms = 0.0;
-    r.sensors.dc_link.noise_v_rms = 0.0;
-    r
-}
-
-/// Root-mean-square of `a − b` over the rows with `t ≥ t_from`.
-fn rms_difference(t: &[f64], a: &[f64], b: &[f64], t_from: f64) -> f64 {
-    let (sum, n) = t
-        .iter()
-        .zip(a.iter().zip(b))
-        .filter(|(t, _)| **t >= t_from)
-        .fold((0.0, 0usize), |(s, n), (_, (x, y))| {
-            (s + (x - y) * (x - y), n + 1)
-        });
-    (sum / n.max(1) as f64).sqrt()
-}
-
-/// One signal's signature of an effect in a closed-loop log.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Signature {
-    /// RMS of (with effect − without), both noise-free: the effect's own trace. [unit]
-    pub effect_rms: f64,
-    /// RMS noise of the signal: RMS of the difference of two effect-free runs with
-    /// different noise seeds, over √2. [unit]
-    pub noise_rms: f64,
-    /// Standard deviation of the signal in the truth log (what the fit measure divides
-    /// by). [unit]
-    pub spread: f64,
-}
-
-impl Signature {
-    /// Effect over noise. [1]
-    pub fn ratio(&self) -> f64 {
-        self.effect_rms / self.noise_rms.max(f64::MIN_POSITIVE)
-    }
-
-    /// The most the fit percentage 100·(1 − ‖y − ŷ‖/‖y − ȳ‖) can gain when a model that
-    /// misses the effect (error ≈ effect + noise) is replaced by one that has it (error ≈
-    /// noise). [percentage points]
-    pub fn attainable_fit_gain(&self) -> f64 {
-        let e = self.effect_rms;
-        let n = self.noise_rms;
-        100.0 * ((e * e + n * n).sqrt() - n) / self.spread.max(f64::MIN_POSITIVE)
-    }
-}
-
-/// The signature of `draw`'s effect on `signal`, measured after `t_from` [s]: the
-/// noise-free truth log against the noise-free log of the same plant without the effect
-/// (the ADCs' and encoder's quantisation stay); the noise from two noisy effect-free runs
-/// with different noise seeds.
-pub fn signature(d: &Draw, signal: Signal, t_from: f64) -> Result<Signature, String> {
-    let with = simulate(&noise_free(&d.truth_rig()), &d.scenario, d.noise_seed)?;
-    let without = simulate(&noise_free(&d.tolerance_rig), &d.scenario, d.noise_seed)?;
-    let noisy = simulate(&d.tolerance_rig, &d.scenario, d.noise_seed)?;
-    let truth = simulate(&d.truth_rig(), &d.scenario, d.noise_seed)?;
-    let other = simulate(
-        &d.tolerance_rig,
-        &d.scenario,
-        d.noise_seed ^ 0x9e37_79b9_7f4a_7c15,
-    )?;
-    let col = |l: &BenchLog| -> Result<Vec<f64>, String> {
-        l.column(signal)
-            .map(<[f64]>::to_vec)
-            .ok_or_else(|| format!("column {} not logged", signal.name()))
-    };
-    let (w, wo, n, o) = (col(&with)?, col(&without)?, col(&noisy)?, col(&other)?);
-    let y = col(&truth)?;
-    let (sum, rows) = truth
-        .t_s
-        .iter()
-        .zip(&y)
-        .filter(|(t, _)| **t >= t_from)
-        .fold((0.0, 0usize), |(s, n), (_, y)| (s + y, n + 1));
-    let mean = vec![sum / rows.max(1) as f64; y.len()];
-    Ok(Signature {
-        effect_rms: rms_difference(&with.t_s, &w, &wo, t_from),
-        noise_rms: rms_difference(&with.t_s, &n, &o, t_from) / 2f64.sqrt(),
-        spread: rms_difference(&truth.t_s, &y, &mean, t_from),
-    })
-}
-
-/// For a draw hiding piston ripple, the most a model with the ripple could gain on the
-/// truth's signal over the log's second half ([`angle_locked_fit_bound`] at the ripple's
-/// orders); `None` for any other effect. When it is below the suite's 10 points, this log
-/// does not tell the ripple from `none` at the suite's standard. [percentage points]
-pub fn ripple_fit_bound(d: &Draw) -> Result<Option<f64>, String> {
-    let Effect::PistonRipple { pistons, .. } = d.effect else {
-        return Ok(None);
-    };
-    let signal = Signal::from_name(d.truth.signal)
-        .ok_or_else(|| format!("{} is not a bench-log column", d.truth.signal))?;
-    let bound = angle_locked_fit_bound(
-        d,
-        &[signal],
-        d.truth.duration_s / 2.0,
-        &ripple_orders(pistons),
-    )?;
-    Ok(bound.first().copied())
-}
-
-/// Every logged signal a diagnosis is scored on (`fit_percent_by_signal` and the voltages
-/// and d current the subsystem replays predict).
-pub const LOGGED: [Signal; 6] = [
-    Signal::Pressure,
-    Signal::Speed,
-    Signal::Iq,
-    Signal::Id,
-    Signal::Ud,
-    Signal::Uq,
-];
-
-/// Harmonics of the piston ripple's fundamental an angle-locked bound fits (the kinematic
-/// shape's cusps put nearly all of its power in the first few).
-pub const RIPPLE_HARMONICS: u32 = 4;
-
-/// The orders (cycles per shaft revolution) of a `z`-piston pump's ripple up to
-/// [`RIPPLE_HARMONICS`].
-pub fn ripple_orders(z: u32) -> Vec<u32> {
-    (1..=RIPPLE_HARMONICS)
-        .map(|k| k * ripple_order(z))
-        .collect()
-}
-
-/// The most a model could gain on each of `signals` after `t_from` by adding, to a PERFECT
-/// effect-free model of the drawn rig (its exact tolerances, noise-free), any periodic
-/// function of the logged shaft angle at `orders` (cycles per revolution): the function is
-/// fitted by least squares to the very rows it is scored on, so this is an upper bound on
-/// what any angle-locked extension can gain on a validation segment, for any parameters of
-/// it. [percentage points, per signal]
-pub fn angle_locked_fit_bound(
-    d: &Draw,
-    signals: &[Signal],
-    t_from: f64,
-    orders: &[u32],
-) -> Result<Vec<f64>, String> {
-    let truth = simulate(&d.truth_rig(), &d.scenario, d.noise_seed)?;
-    let perfect = simulate(&noise_free(&d.tolerance_rig), &d.scenario, d.noise_seed)?;
-    let theta = truth
-        .theta_m_rad
-        .as_deref()
-        .ok_or("the shaft angle is not logged")?;
-    let rows: Vec<usize> = (0..truth.t_s.len())
-        .filter(|&i| truth.t_s[i] >= t_from && i < perfect.t_s.len())
-        .collect();
-    let basis = nalgebra::DMatrix::from_fn(rows.len(), 2 * orders.len(), |r, c| {
-        let phase = f64::from(orders[c / 2]) * theta[rows[r]];
-        if c % 2 == 0 {
-            phase.cos()
-        } else {
-            phase.sin()
-        }
-    });
-    let svd = basis.clone().svd(true, true);
-    signals
-        .iter()
-        .map(|&signal| {
-            let missing = || format!("column {} not logged", signal.name());
-            let y = truth.column(signal).ok_or_else(missing)?;
-            let m = perfect.column(signal).ok_or_else(missing)?;
-            let residual =
-                nalgebra::DVector::from_iterator(rows.len(), rows.iter().map(|&i| y[i] - m[i]));
-            let coefficients = svd.solve(&residual, 1e-12)?;
-            let left = &residual - &basis * coefficients;
-            let mean = rows.iter().map(|&i| y[i]).sum::<f64>() / rows.len().max(1) as f64;
-            let spread = rows
-                .iter()
-                .map(|&i| (y[i] - mean).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            Ok(100.0 * (residual.norm() - left.norm()) / spread.max(f64::MIN_POSITIVE))
-        })
-        .collect()
 }
 
 #[cfg(test)]
