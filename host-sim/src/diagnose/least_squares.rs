@@ -306,6 +306,11 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
 /// Iterations the optimiser may spend per parameter (its `patience`).
 const PATIENCE: usize = 25;
 
+/// Relative reduction of the objective (and of the step) below which the optimiser stops:
+/// on objectives of 10⁴–10⁵ noise units a millionth is a tenth of a unit, far below the
+/// χ² thresholds (15–18) the decision compares differences with. [1]
+const FTOL: f64 = 1e-6;
+
 /// Fits `specs` to `model` from their starts.
 pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
     // A start on a bound would freeze the search there (the sine transform is flat at its
@@ -329,8 +334,8 @@ pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
     } else {
         let (p, r) = LevenbergMarquardt::<f64>::new()
             .with_patience(PATIENCE)
-            .with_ftol(1e-8)
-            .with_xtol(1e-8)
+            .with_ftol(FTOL)
+            .with_xtol(FTOL)
             .minimize(problem);
         (p, Some(r))
     };
