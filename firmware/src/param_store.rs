@@ -18,8 +18,9 @@
 //! never a mixture. A record counts only when its CRC matches *and* its commit word is
 //! present; the commit word is written after the record, so a record interrupted after
 //! its last data word but before the commit is not taken either. The sequence number
-//! (newer = larger) decides between two valid slots. Two slots cost twice the record's
-//! pages of flash; a log-structured store (e.g. `sequential-storage`) would level wear, but the
+//! (newer = larger, counted with wrap-around) decides between two valid slots. Two slots cost
+//! twice the record's pages of flash; a log-structured store (e.g. `sequential-storage`) would
+//! level wear, but the
 //! table is saved by an operator, a few times in a drive's life, far below the 10 000
 //! erase cycles of the G4's flash, and the A/B scheme is a fraction of the code size.
 //!
@@ -209,12 +210,18 @@ impl<F: NorFlash> ParamStore<F> {
     }
 }
 
-/// The valid page with the largest sequence number: (page index, sequence, values).
+/// Whether sequence `a` is newer than `b` in serial-number arithmetic (RFC 1982): `save`
+/// counts on with wrapping, so the record after `u32::MAX` is 0, and it must win.
+fn is_newer(a: u32, b: u32) -> bool {
+    (a.wrapping_sub(b) as i32) > 0
+}
+
+/// The valid page with the newer sequence number: (page index, sequence, values).
 fn newest(pages: &[Page; 2]) -> Option<(usize, u32, [f32; COUNT])> {
     let mut best: Option<(usize, u32, [f32; COUNT])> = None;
     for (i, p) in pages.iter().enumerate() {
         if let Page::Valid { sequence, values } = *p {
-            if best.is_none_or(|(_, s, _)| sequence > s) {
+            if best.is_none_or(|(_, s, _)| is_newer(sequence, s)) {
                 best = Some((i, sequence, values));
             }
         }

@@ -156,16 +156,22 @@ impl TelemetryFrame {
 
     /// Packs the frame into the compact record ([`COMPACT_LEN`] bytes).
     pub fn to_compact(&self) -> [u8; COMPACT_LEN] {
-        let us = self.t_s * 1e6;
-        let t = if us.is_finite() && us > 0.0 {
+        // Rounded to the nearest microsecond: t_s of a decoded record is the count times
+        // 1e-6, which times 1e6 may fall a hair below the count (826361925 µs came back as
+        // 826361924.99999 and was truncated to the microsecond before).
+        let us = self.t_s * 1e6 + 0.5;
+        let t = if us.is_finite() && us >= 1.0 {
             (us as u64 & 0xffff_ffff) as u32
         } else {
             0
         };
         let words: [[u8; 4]; 12] = [
             t.to_le_bytes(),
-            I8F24::saturating_from_num(finite(self.p_ref_pa) * 1e-6).to_le_bytes(),
-            I8F24::saturating_from_num(finite(self.p_pa) * 1e-6).to_le_bytes(),
+            // MPa scaled in f64: in f32 the product is rounded to the pressure's own ulp
+            // (0.5 Pa at 5 MPa) before the 0.06 Pa quantisation, and a decoded record
+            // would not re-encode to itself.
+            I8F24::saturating_from_num(f64::from(finite(self.p_ref_pa)) * 1e-6).to_le_bytes(),
+            I8F24::saturating_from_num(f64::from(finite(self.p_pa)) * 1e-6).to_le_bytes(),
             I16F16::saturating_from_num(finite(self.speed_rad_s)).to_le_bytes(),
             I16F16::saturating_from_num(finite(self.speed_ref_rad_s)).to_le_bytes(),
             I12F20::saturating_from_num(finite(self.iq_a)).to_le_bytes(),
@@ -198,8 +204,8 @@ impl TelemetryFrame {
         let i12 = |i: usize| I12F20::from_le_bytes(w(i)).to_num::<f32>();
         Ok(TelemetryFrame {
             t_s: u32::from_le_bytes(w(0)) as f64 * 1e-6,
-            p_ref_pa: I8F24::from_le_bytes(w(1)).to_num::<f32>() * 1e6,
-            p_pa: I8F24::from_le_bytes(w(2)).to_num::<f32>() * 1e6,
+            p_ref_pa: (I8F24::from_le_bytes(w(1)).to_num::<f64>() * 1e6) as f32,
+            p_pa: (I8F24::from_le_bytes(w(2)).to_num::<f64>() * 1e6) as f32,
             speed_rad_s: I16F16::from_le_bytes(w(3)).to_num(),
             speed_ref_rad_s: I16F16::from_le_bytes(w(4)).to_num(),
             iq_a: i12(5),
@@ -252,12 +258,21 @@ impl fmt::Display for ParseError {
             ParseError::NoTag => write!(f, "no `{LINE_TAG} ` tag in the line"),
             ParseError::Missing(k) => write!(f, "field `{k}` missing or out of order"),
             ParseError::BadValue(k) => write!(f, "field `{k}` is not a number"),
-            ParseError::BadMode => write!(f, "field `mode` is not a mode code (0..=3)"),
-            ParseError::BadFault => write!(
-                f,
-                "field `fault` is not a fault code (0..={})",
-                FaultCode::MAX_CODE
-            ),
+            ParseError::BadMode => {
+                let last = (0..=u8::MAX)
+                    .take_while(|c| Mode::from_code(*c).is_some())
+                    .last()
+                    .unwrap_or(0);
+                write!(f, "field `mode` is not a mode code (0..={last})")
+            }
+            ParseError::BadFault => {
+                // 0 is "no fault"; the codes are the supervisor's enumeration.
+                let last = FaultCode::MAX_CODE;
+                write!(
+                    f,
+                    "field `fault` is not a fault code (0..={last}: 0 none, 1..={last} a fault)"
+                )
+            }
         }
     }
 }
@@ -381,6 +396,74 @@ mod tests {
             message.contains(&std::format!("0..={}", FaultCode::ALL.len())),
             "{message}"
         );
+    }
+
+    #[test]
+    fn the_fault_code_message_spans_every_code_the_parser_accepts() {
+        // The codes the parser accepts, found by trying each byte, not from the message.
+        let line = |code: u8| {
+            let mut s = String::new();
+            frame().write_line(&mut s).unwrap();
+            let cut = s.find(" fault=").unwrap();
+            let rest = &s[cut + " fault=".len()..];
+            let after = rest.find(' ').unwrap();
+            format!("{} fault={code}{}", &s[..cut], &rest[after..])
+        };
+        let accepted: Vec<u8> = (0..=u8::MAX)
+            .filter(|c| parse_line(&line(*c)).is_ok())
+            .collect();
+        let last = *accepted.last().unwrap();
+        assert_eq!(
+            accepted,
+            (0..=last).collect::<Vec<u8>>(),
+            "contiguous from 0"
+        );
+        assert!(last >= 16, "the supervisor has at least 16 fault codes");
+        assert_eq!(parse_line(&line(last + 1)), Err(ParseError::BadFault));
+        let msg = format!("{}", ParseError::BadFault);
+        assert!(msg.contains(&format!("1..={last}")), "{msg}");
+    }
+
+    #[test]
+    fn compact_time_survives_a_decode_and_encode() {
+        // Found by fuzzing: the time was truncated, so a decoded record re-encoded lost a
+        // microsecond (826361925 → 826361924).
+        for us in [0u32, 1, 149, 150, 826_361_925, 4_294_967_295] {
+            let mut r = frame().to_compact();
+            r[..4].copy_from_slice(&us.to_le_bytes());
+            let again = TelemetryFrame::from_compact(&r).unwrap().to_compact();
+            assert_eq!(again[..4], us.to_le_bytes(), "{us} µs");
+        }
+        // The controller's own times, sample counts at 20 kHz, land on whole microseconds.
+        for k in 0..200_000u32 {
+            let mut f = frame();
+            f.t_s = f64::from(k) / 20_000.0;
+            let word = u32::from_le_bytes(f.to_compact()[..4].try_into().unwrap());
+            assert_eq!(word, 50 * k, "sample {k}");
+        }
+    }
+
+    #[test]
+    fn compact_pressures_survive_a_decode_and_encode() {
+        // Found by fuzzing: scaled to MPa in f32, −115874264 Pa re-encoded one f32 ulp off.
+        for mpa in [-128.0f64, -115.874264, -0.000_06, 0.0, 4.99, 127.999_99] {
+            let mut r = frame().to_compact();
+            let word = I8F24::saturating_from_num(mpa).to_le_bytes();
+            r[4..8].copy_from_slice(&word);
+            r[8..12].copy_from_slice(&word);
+            let f = TelemetryFrame::from_compact(&r).unwrap();
+            let g = TelemetryFrame::from_compact(&f.to_compact()).unwrap();
+            assert_eq!(
+                (f.p_pa.to_bits(), f.p_ref_pa.to_bits()),
+                (g.p_pa.to_bits(), g.p_ref_pa.to_bits()),
+                "{mpa} MPa"
+            );
+        }
+        // The stated 0.06 Pa resolution holds in the encoding, not only an f32 ulp.
+        let mut f = frame();
+        f.p_pa = 5_000_000.5;
+        let g = TelemetryFrame::from_compact(&f.to_compact()).unwrap();
+        assert_eq!(g.p_pa, 5_000_000.5);
     }
 
     #[test]

@@ -13,16 +13,45 @@
 //! output file. A bench log from a partly garbled capture would look trustworthy to `eha
 //! diagnose` and `eha tune`; re-capturing (or cutting the log at the reset) is the fix.
 
+use crate::bench_log::limits::{
+    line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS,
+};
 use crate::bench_log::{self, BenchLog, Signal, MIN_ROWS};
-use crate::cli::{CliError, IngestArgs};
+use crate::output::paths::Declared;
+use crate::output::CliError;
+use clap::Args;
 use firmware::telemetry::{parse_line, ParseError, TelemetryFrame, COLUMNS};
 use std::fmt;
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
+/// `eha ingest`.
+#[derive(Debug, Args)]
+pub struct IngestArgs {
+    /// The decoder's output (`probe-rs run` or `defmt-print`).
+    #[arg(value_name = "DEFMT_LOG")]
+    pub defmt_log: PathBuf,
+    /// Bench log to write.
+    #[arg(long, value_name = "LOG.csv")]
+    pub out: PathBuf,
+}
+
+impl IngestArgs {
+    /// The files it reads and writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default()
+            .input("DEFMT_LOG", Some(&self.defmt_log))
+            .file("--out", Some(&self.out))
+    }
+}
+
 /// How many malformed lines the error message lists (all are counted).
 const LISTED: usize = 10;
+
+/// How many malformed lines are kept (the rest only counted: a capture of garbage must not
+/// fill the memory).
+pub const KEPT: usize = 100;
 
 /// What is wrong with one telemetry line.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,6 +60,9 @@ pub enum LineProblem {
     Parse(ParseError),
     /// A field parsed to NaN or an infinity (the bench log holds finite numbers only).
     NotFinite(&'static str),
+    /// A field outside its column's physical range (the bench log's
+    /// [`physical_range`]).
+    OutOfRange(&'static str, f64),
     /// The frame's time does not exceed the previous frame's.
     TimeNotIncreasing {
         /// The previous frame's time. [s]
@@ -45,6 +77,14 @@ impl fmt::Display for LineProblem {
         match self {
             LineProblem::Parse(e) => write!(f, "{e}"),
             LineProblem::NotFinite(k) => write!(f, "field `{k}` is not a finite number"),
+            LineProblem::OutOfRange(k, v) => {
+                let (low, high, unit) = Signal::from_name(k).map_or((0.0, 0.0, ""), physical_range);
+                write!(
+                    f,
+                    "field `{k}` = {v:e} {unit} lies outside the physical range {low:e} to \
+                     {high:e} {unit}"
+                )
+            }
             LineProblem::TimeNotIncreasing { previous, value } => write!(
                 f,
                 "field `t_s`: time {value} s does not exceed the previous frame's {previous} s \
@@ -70,8 +110,10 @@ pub struct Ingested {
     pub log: BenchLog,
     /// Lines without the telemetry tag, skipped.
     pub skipped: usize,
-    /// Telemetry lines that do not parse or break the bench-log rules.
+    /// Telemetry lines that do not parse or break the bench-log rules: the first [`KEPT`].
     pub malformed: Vec<Malformed>,
+    /// How many telemetry lines were malformed in all.
+    pub malformed_count: usize,
     /// Frames that carried a latched fault.
     pub faulted_frames: usize,
 }
@@ -80,6 +122,14 @@ impl Ingested {
     /// Telemetry frames taken into the log.
     pub fn frames(&self) -> usize {
         self.log.len()
+    }
+
+    /// Counts a malformed line, keeping the first [`KEPT`].
+    fn note(&mut self, line: usize, problem: LineProblem) {
+        self.malformed_count += 1;
+        if self.malformed.len() < KEPT {
+            self.malformed.push(Malformed { line, problem });
+        }
     }
 }
 
@@ -95,12 +145,36 @@ pub enum IngestError {
         source: std::io::Error,
     },
     /// Malformed telemetry lines (all counted, the first few listed).
-    #[error("{}", malformed_message(file, malformed))]
+    #[error("{}", malformed_message(file, malformed, *count))]
     Malformed {
         /// The file.
         file: PathBuf,
-        /// Every malformed line.
+        /// The first malformed lines.
         malformed: Vec<Malformed>,
+        /// How many there are.
+        count: usize,
+    },
+    /// A line longer than any decoder prints (a binary file?).
+    #[error(
+        "defmt log `{}`, line {line}: longer than {} bytes; not a decoder's text output",
+        file.display(),
+        MAX_LINE_BYTES
+    )]
+    LineTooLong {
+        /// The file.
+        file: PathBuf,
+        /// 1-based line.
+        line: usize,
+    },
+    /// More telemetry frames than a bench log may hold.
+    #[error(
+        "defmt log `{}`: more than {MAX_ROWS} telemetry lines; a bench log holds at most that \
+         many rows (split the capture)",
+        file.display()
+    )]
+    TooManyFrames {
+        /// The file.
+        file: PathBuf,
     },
     /// Too few frames for a bench log.
     #[error(
@@ -118,18 +192,18 @@ pub enum IngestError {
     },
 }
 
-fn malformed_message(file: &Path, malformed: &[Malformed]) -> String {
+fn malformed_message(file: &Path, malformed: &[Malformed], count: usize) -> String {
     let mut s = format!(
         "defmt log `{}`: {} malformed telemetry line{}",
         file.display(),
-        malformed.len(),
-        if malformed.len() == 1 { "" } else { "s" }
+        count,
+        if count == 1 { "" } else { "s" }
     );
     for m in malformed.iter().take(LISTED) {
         s.push_str(&format!("\n  {}:{}: {}", file.display(), m.line, m.problem));
     }
-    if malformed.len() > LISTED {
-        s.push_str(&format!("\n  … and {} more", malformed.len() - LISTED));
+    if count > LISTED {
+        s.push_str(&format!("\n  … and {} more", count - LISTED));
     }
     s
 }
@@ -146,6 +220,14 @@ fn non_finite_field(f: &TelemetryFrame) -> Option<&'static str> {
         .skip(1)
         .find(|(_, x)| !x.is_finite())
         .map(|(k, _)| *k)
+}
+
+/// The first field of a frame outside its column's physical range, with its value.
+fn out_of_range_field(f: &TelemetryFrame) -> Option<(&'static str, f64)> {
+    COLUMNS.iter().zip(frame_values(f)).find_map(|(k, v)| {
+        let (low, high, _) = physical_range(Signal::from_name(k)?);
+        (!(low..=high).contains(&v)).then_some((*k, v))
+    })
 }
 
 /// A frame's values in [`COLUMNS`] order (the bench-log column names). [SI]
@@ -175,12 +257,19 @@ pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), 
     let mut last_t: Option<f64> = None;
     loop {
         buf.clear();
-        let n = input
-            .read_until(b'\n', &mut buf)
-            .map_err(|source| IngestError::Read {
-                file: file.to_path_buf(),
-                source,
-            })?;
+        let n =
+            input
+                .read_until(b'\n', &mut buf)
+                .map_err(|source| match line_too_long(&source) {
+                    Some(line) => IngestError::LineTooLong {
+                        file: file.to_path_buf(),
+                        line,
+                    },
+                    None => IngestError::Read {
+                        file: file.to_path_buf(),
+                        source,
+                    },
+                })?;
         if n == 0 {
             break;
         }
@@ -189,10 +278,6 @@ pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), 
         // telemetry; telemetry itself is ASCII, so a lossy view loses nothing of it.
         let text = String::from_utf8_lossy(&buf);
         let text = text.trim_end_matches(['\n', '\r']);
-        let bad = |problem| Malformed {
-            line: line_no,
-            problem,
-        };
         let frame = match parse_line(text) {
             Ok(f) => f,
             Err(ParseError::NoTag) => {
@@ -200,20 +285,32 @@ pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), 
                 continue;
             }
             Err(e) => {
-                out.malformed.push(bad(LineProblem::Parse(e)));
+                out.note(line_no, LineProblem::Parse(e));
                 continue;
             }
         };
         if let Some(k) = non_finite_field(&frame) {
-            out.malformed.push(bad(LineProblem::NotFinite(k)));
+            out.note(line_no, LineProblem::NotFinite(k));
+            continue;
+        }
+        if let Some((k, v)) = out_of_range_field(&frame) {
+            out.note(line_no, LineProblem::OutOfRange(k, v));
             continue;
         }
         if let Some(previous) = last_t.filter(|p| frame.t_s <= *p) {
-            out.malformed.push(bad(LineProblem::TimeNotIncreasing {
-                previous,
-                value: frame.t_s,
-            }));
+            out.note(
+                line_no,
+                LineProblem::TimeNotIncreasing {
+                    previous,
+                    value: frame.t_s,
+                },
+            );
             continue;
+        }
+        if out.frames() == MAX_ROWS {
+            return Err(IngestError::TooManyFrames {
+                file: file.to_path_buf(),
+            });
         }
         last_t = Some(frame.t_s);
         if frame.fault.is_some() {
@@ -233,10 +330,11 @@ pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), 
 
 /// Fails on any malformed line and on too few frames for a bench log.
 pub fn check(ingested: &Ingested, lines: usize, file: &Path) -> Result<(), IngestError> {
-    if !ingested.malformed.is_empty() {
+    if ingested.malformed_count > 0 {
         return Err(IngestError::Malformed {
             file: file.to_path_buf(),
             malformed: ingested.malformed.clone(),
+            count: ingested.malformed_count,
         });
     }
     if ingested.frames() < MIN_ROWS {
@@ -261,8 +359,8 @@ pub fn run_ingest(args: &IngestArgs) -> Result<(), CliError> {
             .to_string(),
         )
     })?;
-    let (mut ingested, lines) =
-        read(BufReader::new(input), file).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let (mut ingested, lines) = read(BufReader::new(LineLimited::new(input)), file)
+        .map_err(|e| CliError::BadInput(e.to_string()))?;
     check(&ingested, lines, file).map_err(|e| CliError::BadInput(e.to_string()))?;
     let name = file
         .file_name()

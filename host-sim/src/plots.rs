@@ -1,4 +1,11 @@
 //! SVG plots (plotters): time traces, spectra with the physical orders marked, sweep curves.
+//!
+//! Points that are not finite are left out, and the axes span at most [`MAX_SPAN`]: a
+//! range beyond it (values near ±1e308, whose difference overflows) would leave plotters'
+//! tick search without end.
+
+/// Widest axis span drawn (a plot of wider data is refused, not drawn). [axis unit]
+pub const MAX_SPAN: f64 = 1e100;
 
 use plotters::prelude::*;
 use std::path::Path;
@@ -31,7 +38,7 @@ const COLOURS: [RGBColor; 6] = [
 fn bounds(series: &[Series], log_y: bool) -> (f64, f64, f64, f64) {
     let mut b = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for p in series.iter().flat_map(|s| &s.points) {
-        if log_y && p.1 <= 0.0 {
+        if !drawable(p, log_y) {
             continue;
         }
         b = (b.0.min(p.0), b.1.max(p.0), b.2.min(p.1), b.3.max(p.1));
@@ -54,6 +61,11 @@ fn bounds(series: &[Series], log_y: bool) -> (f64, f64, f64, f64) {
     b
 }
 
+/// Whether a point can be drawn: finite, and positive on a log scale.
+fn drawable(p: &(f64, f64), log_y: bool) -> bool {
+    p.0.is_finite() && p.1.is_finite() && (!log_y || p.1 > 0.0)
+}
+
 /// A line chart written to `path` (SVG). `log_y` plots y on a log scale.
 pub fn line_chart(
     path: &Path,
@@ -64,10 +76,23 @@ pub fn line_chart(
     markers: &[Marker],
     log_y: bool,
 ) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| format!("plot `{}`: {e}", path.display());
+    // Named by its file name: the folder may be a staging folder the user never sees.
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let err = |e: &dyn std::fmt::Display| format!("plot `{name}`: {e}");
+    let (x0, x1, y0, y1) = bounds(series, log_y);
+    let span_ok = |s: f64| s.is_finite() && s <= MAX_SPAN;
+    if !(span_ok(x1 - x0) && span_ok(y1 - y0)) {
+        return Err(err(&format_args!(
+            "the data span {:e} by {:e}, too wide to draw",
+            x1 - x0,
+            y1 - y0
+        )));
+    }
     let root = SVGBackend::new(path, (960, 540)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let (x0, x1, y0, y1) = bounds(series, log_y);
     let mut builder = ChartBuilder::on(&root);
     builder
         .caption(title, ("sans-serif", 22))
@@ -89,7 +114,7 @@ pub fn line_chart(
                     .points
                     .iter()
                     .copied()
-                    .filter(|p| !log_y || p.1 > 0.0)
+                    .filter(|p| drawable(p, log_y))
                     .collect();
                 chart
                     .draw_series(LineSeries::new(pts, c.stroke_width(1)))
@@ -133,4 +158,33 @@ pub fn line_chart(
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extreme_and_non_finite_points_end_quickly() {
+        let dir = std::env::temp_dir().join(format!("eha-plots-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.svg");
+        let wild = Series {
+            name: "wild",
+            points: vec![
+                (0.0, 1e308),
+                (1.0, -1e308),
+                (2.0, f64::NAN),
+                (3.0, f64::INFINITY),
+            ],
+        };
+        let e = line_chart(&path, "t", "x", "y", &[wild], &[], false).unwrap_err();
+        assert!(e.contains("too wide"), "{e}");
+        let tame = Series {
+            name: "tame",
+            points: vec![(0.0, 1.0), (1.0, f64::NAN), (2.0, 3.0)],
+        };
+        line_chart(&path, "t", "x", "y", &[tame], &[], false).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -7,15 +7,48 @@
 //! and types (line, column and key, from the TOML parser), keys the rig does not have (a
 //! misspelt key would otherwise be ignored silently), then the physics ([`Rig::validate`],
 //! naming the parameter). A file must give every parameter: start from `eha rig > my.toml`.
+//!
+//! `eha rig` ([`run_rig`]) prints a rig in this format.
 
+use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use clap::Args;
 use plant_model::{Rig, RigError};
+use std::io::Read as _;
 use std::path::{Path, PathBuf};
+
+/// `eha rig`.
+#[derive(Debug, Args)]
+pub struct RigArgs {
+    /// Also write the rig as JSON (`-`: standard output, instead of the TOML).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+impl RigArgs {
+    /// The files it writes.
+    pub fn paths(&self) -> crate::output::paths::Declared<'_> {
+        crate::output::paths::Declared::default().file("--json", self.json.as_ref())
+    }
+}
+
+/// `eha rig`: the TOML on standard output; with `--json PATH` the JSON too (with `--json -`
+/// only the JSON, so standard output stays one parseable document).
+pub fn run_rig(rig: &Rig, a: &RigArgs) -> Result<(), CliError> {
+    if let Some(path) = &a.json {
+        let value = serde_json::to_value(rig).map_err(|e| CliError::Failed(e.to_string()))?;
+        write_json(path, &value)?;
+        if is_stdout(path) {
+            return Ok(());
+        }
+    }
+    print_stdout(&to_toml(rig))
+}
 
 /// A rig file that cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum RigFileError {
     /// The file cannot be read.
-    #[error("rig file `{}`: {source}", file.display())]
+    #[error("rig file `{}`: {}", file.display(), crate::output::paths::describe(source))]
     Read {
         /// The file.
         file: PathBuf,
@@ -55,11 +88,34 @@ pub enum RigFileError {
     },
 }
 
-/// Reads, parses and validates the rig file at `path`.
+/// The largest rig file read: the nominal rig is under 3 kB. [bytes]
+pub const MAX_BYTES: u64 = 1 << 20;
+
+/// Reads, parses and validates the rig file at `path` (a regular file or a pipe of at most
+/// [`MAX_BYTES`] of UTF-8 text).
 pub fn load(path: &Path) -> Result<Rig, RigFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| RigFileError::Read {
+    let read_err = |source| RigFileError::Read {
         file: path.to_path_buf(),
         source,
+    };
+    let refuse = |why: String| read_err(std::io::Error::new(std::io::ErrorKind::InvalidInput, why));
+    if let Some(why) = crate::output::paths::input_problem(path) {
+        return Err(refuse(why));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(read_err)?;
+    if bytes.len() as u64 > MAX_BYTES {
+        return Err(refuse(format!(
+            "larger than {MAX_BYTES} bytes; a rig file is a few kilobytes of TOML"
+        )));
+    }
+    let text = String::from_utf8(bytes).map_err(|e| {
+        refuse(format!(
+            "not UTF-8 text (byte {})",
+            e.utf8_error().valid_up_to()
+        ))
     })?;
     from_toml(&text, path)
 }

@@ -3,7 +3,13 @@
 //! measured and commanded quantities) plus the plant-side columns a rig's extra sensors
 //! would give (piston position, low-side pressure), and the true port pressure kept aside
 //! for the pulsation study.
+//!
+//! A run is bounded before it starts: it may log at most the bench log's
+//! [`MAX_ROWS`](crate::bench_log::limits::MAX_ROWS) rows ([`log_plan`]); [`first_unphysical`]
+//! finds where a run's state left the physical range (a rig the integration cannot follow),
+//! for the commands to report instead of writing it.
 
+use crate::bench_log::limits::{physical_range, MAX_ROWS};
 use crate::bench_log::BenchLog;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -41,8 +47,34 @@ pub struct RunOptions {
     pub metadata: Vec<(String, String)>,
 }
 
+/// How a run of `duration_s` [s] is logged at `log_rate_hz` [Hz] with the PWM period
+/// `period_s` [s]: every how many periods a row is taken, and how many rows that gives.
+pub fn log_plan(duration_s: f64, log_rate_hz: f64, period_s: f64) -> (u32, f64) {
+    let every = ((1.0 / log_rate_hz) / period_s)
+        .round()
+        .clamp(1.0, u32::MAX as f64) as u32;
+    let rows = (duration_s / (period_s * every as f64)).ceil();
+    (every, rows)
+}
+
+/// The first logged value outside its column's physical range (NaN included): its time,
+/// column and value.
+pub fn first_unphysical(log: &BenchLog) -> Option<(f64, &'static str, f64)> {
+    let mut first: Option<(usize, &'static str, f64)> = None;
+    for (signal, column) in log.columns() {
+        let (low, high, _) = physical_range(signal);
+        if let Some(i) = column.iter().position(|v| !(low..=high).contains(v)) {
+            if first.is_none_or(|(j, _, _)| i < j) {
+                first = Some((i, signal.name(), column[i]));
+            }
+        }
+    }
+    first.map(|(i, name, v)| (log.t_s.get(i).copied().unwrap_or(f64::NAN), name, v))
+}
+
 /// Runs `scenario` on the plant `plant_rig`, controlled by the configuration of
-/// `controller_rig` (the rig file the engineer believes in).
+/// `controller_rig` (the rig file the engineer believes in). Fails before any work if the
+/// log would exceed [`MAX_ROWS`].
 pub fn run(
     plant_rig: &Rig,
     controller_rig: &Rig,
@@ -52,8 +84,14 @@ pub fn run(
     let config = controller_config(controller_rig);
     let mut cl =
         ClosedLoop::new(plant_rig, &config, scenario, opt.seed).map_err(|e| e.to_string())?;
-    let every = ((1.0 / opt.log_rate_hz) / cl.period_s()).round().max(1.0) as u32;
-    let n_rows = (opt.duration_s / (cl.period_s() * every as f64)).ceil() as usize;
+    let (every, rows) = log_plan(opt.duration_s, opt.log_rate_hz, cl.period_s());
+    if rows.is_nan() || rows > MAX_ROWS as f64 {
+        return Err(format!(
+            "{} s at {} Hz would log {rows:.0} rows; a bench log holds at most {MAX_ROWS}",
+            opt.duration_s, opt.log_rate_hz
+        ));
+    }
+    let n_rows = rows as usize;
     let mut log = BenchLog {
         metadata: opt.metadata.clone(),
         ..BenchLog::default()

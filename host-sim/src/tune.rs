@@ -7,7 +7,8 @@
 //!   plant equation) and design;
 //! - [`candidates`], [`predict`]: the closed-loop replays (the firmware's control core
 //!   against the plant model) the proposal is chosen and predicted with;
-//! - [`can`]: the `SetParameter` frames.
+//! - [`can`]: the `SetParameter` frames;
+//! - [`report`]: the JSON document and the text printed.
 //!
 //! The *current* gains are those of the controller configured from the rig (`--rig`, the
 //! rig the engineer believes in): for the pressure loop, its schedule's gains at the step's
@@ -16,22 +17,64 @@
 pub mod can;
 pub mod candidates;
 pub mod fit;
+pub mod glitch;
 pub mod predict;
 pub mod pressure;
+pub mod report;
 pub mod speed;
 pub mod step;
 
 use crate::bench_log::BenchLog;
-use crate::cli::{is_stdout, print_stdout, write_json, CliError, LoopKind, TuneArgs};
+use crate::output::paths::Declared;
+use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::values::{non_negative_f64, positive_f64, show};
 use can::Setting;
+use clap::{Args, ValueEnum};
 use closed_loop::controller_config;
 use firmware::config::Config;
 use firmware::parameters::ParamId;
 use plant_model::Rig;
 use predict::StepSpec;
-use serde_json::{json, Value};
-use std::fmt::Write as _;
+use std::path::PathBuf;
 use step::{Signal, Step, StepError, StepMetrics, Target};
+
+/// Which loop `eha tune` identifies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LoopKind {
+    /// Speed loop (speed reference step).
+    Speed,
+    /// Pressure loop (pressure setpoint step).
+    Pressure,
+}
+
+/// `eha tune`.
+#[derive(Debug, Args)]
+pub struct TuneArgs {
+    /// Bench log with a setpoint step.
+    #[arg(value_name = "LOG.csv")]
+    pub log: PathBuf,
+    /// The loop to tune.
+    #[arg(long = "loop", value_enum)]
+    pub loop_kind: LoopKind,
+    /// Overshoot target. [%]
+    #[arg(long, value_name = "PCT", value_parser = non_negative_f64, allow_negative_numbers = true)]
+    pub overshoot: Option<f64>,
+    /// Settling-time target. [s]
+    #[arg(long, value_name = "S", value_parser = positive_f64, allow_negative_numbers = true)]
+    pub settling: Option<f64>,
+    /// Write the results as JSON (`-`: standard output).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+impl TuneArgs {
+    /// The files it reads and writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default()
+            .input("LOG", Some(&self.log))
+            .file("--json", self.json.as_ref())
+    }
+}
 
 /// Default target of the speed loop: what its documented design (Table 1 gains, poles at
 /// −67 and −143 rad/s with the PI zero at −50 rad/s) achieves on the nominal rig with
@@ -162,9 +205,11 @@ pub fn tune(
     target: Target,
 ) -> Result<Tuning, TuneError> {
     let config = controller_config(rig);
-    config
-        .validate()
-        .map_err(|e| TuneError::BadLog(format!("the rig's controller configuration: {e:?}")))?;
+    config.validate().map_err(|e| {
+        TuneError::BadLog(format!(
+            "the rig gives a controller configuration the firmware refuses: {e}"
+        ))
+    })?;
     let (signal, reference, response) = match kind {
         LoopKind::Speed => {
             let r = log.speed_ref_rad_s.as_deref().ok_or_else(|| {
@@ -185,6 +230,23 @@ pub fn tune(
              {:.0} rad/s, at the {limit:.0} rad/s limit (a saturated pressure loop, not a \
              speed setpoint)",
             step.from, step.to
+        )));
+    }
+    // A lone sample leaving both neighbours by half the step is no response of the loop.
+    if let Some(k) = glitch::lone_spike(response, 0.5 * (step.to - step.from).abs()) {
+        let (column, unit, scale) = match kind {
+            LoopKind::Speed => ("speed_rad_s", "rad/s", 1.0),
+            LoopKind::Pressure => ("p_pa", "MPa", 1e-6),
+        };
+        return Err(TuneError::BadLog(format!(
+            "the log's {column} at t = {:.4} s (data row {}) reads {:.4} {unit} between {:.4} and \
+             {:.4} {unit}: a dropped or corrupted sample, which would bias the identification; \
+             repair or remove that row",
+            log.t_s[k],
+            k + 1,
+            response[k] * scale,
+            response[k - 1] * scale,
+            response[k + 1] * scale
         )));
     }
     let measured = step::metrics(&log.t_s, response, &step, signal);
@@ -310,6 +372,7 @@ fn no_step(kind: LoopKind, e: StepError) -> TuneError {
 fn tune_speed(job: &Job) -> Result<LoopTuning, TuneError> {
     let (rig, config, log, step, target) = (job.rig, job.config, job.log, job.step, job.target);
     let shaft = speed::identify(rig, log, &step).map_err(TuneError::BadLog)?;
+    simulatable(&speed::identified_rig(rig, &shaft), "speed response")?;
     let spec = replay_spec(Signal::Speed, log, &step, log.p_pa[0], &target);
     let proposal =
         speed::propose(rig, config, &shaft, &spec, &target).map_err(TuneError::Failed)?;
@@ -325,6 +388,7 @@ fn tune_speed(job: &Job) -> Result<LoopTuning, TuneError> {
 fn tune_pressure(job: &Job) -> Result<LoopTuning, TuneError> {
     let (rig, config, log, step, target) = (job.rig, job.config, job.log, job.step, job.target);
     let high = pressure::identify(rig, log).map_err(TuneError::BadLog)?;
+    simulatable(&pressure::identified_rig(rig, &high), "pressure response")?;
     let p_start = log.p_pa[step.start.saturating_sub(1)];
     let spec = replay_spec(Signal::Pressure, log, &step, p_start, &target);
     let proposal =
@@ -342,6 +406,18 @@ fn tune_pressure(job: &Job) -> Result<LoopTuning, TuneError> {
     };
     let plant = pressure::identified_rig(rig, &high);
     finish(spec, identified, proposal, &plant, config)
+}
+
+/// Checks that the plant identified from the log's `what` can be simulated: a log whose
+/// response no plant of this kind produces (a sensor scaled wrongly, data of another
+/// machine) is bad input, said before any proposal is attempted.
+fn simulatable(plant: &Rig, what: &str) -> Result<(), TuneError> {
+    plant.validate().map_err(|e| {
+        TuneError::BadLog(format!(
+            "the log's {what} identifies a plant that cannot be simulated ({e}): is the log \
+             of this rig, its units SI?"
+        ))
+    })
 }
 
 /// The replay of the log's step: the scenarios' lead time at the initial setpoint (0.1 s
@@ -380,201 +456,54 @@ fn finish(
     Ok((spec, identified, proposal, replayed.metrics))
 }
 
-fn metrics_json(m: &StepMetrics, target: &Target) -> Value {
-    json!({
-        "overshoot_percent": m.overshoot_percent,
-        "settling_s": m.settling_s,
-        "meets_target": m.meets(target),
-    })
-}
+/// The longest settling target per loop: the step is replayed for twice the target on
+/// each candidate design, so the target bounds the run time (a few seconds at these
+/// limits); no tuning of this drive asks for slower loops. [s]
+pub const MAX_SETTLING_S: [(LoopKind, f64); 2] =
+    [(LoopKind::Speed, 2.0), (LoopKind::Pressure, 10.0)];
 
-impl Tuning {
-    /// The `--json` document (`contracts/eha-cli.md`; `settling_s` is null for a response
-    /// that has not settled by the end of its window).
-    pub fn to_json(&self, commands: &[String]) -> Value {
-        let identified = match &self.identified {
-            Identified::Speed {
-                shaft,
-                assumed_inertia_kg_m2,
-                assumed_viscous_nm_s,
-            } => json!({
-                "inertia_kg_m2": shaft.inertia_kg_m2,
-                "viscous_nm_s": shaft.viscous_nm_s,
-                "load_nm": shaft.load_nm,
-                "fit_percent": shaft.fit_percent,
-                "assumed_inertia_kg_m2": assumed_inertia_kg_m2,
-                "assumed_viscous_nm_s": assumed_viscous_nm_s,
-            }),
-            Identified::Pressure {
-                high,
-                assumed_precharge_pa,
-                assumed_oil_capacitance_m3_per_pa,
-                capacitance_m3_per_pa,
-                assumed_capacitance_m3_per_pa,
-            } => json!({
-                "capacitance_m3_per_pa": capacitance_m3_per_pa,
-                "assumed_capacitance_m3_per_pa": assumed_capacitance_m3_per_pa,
-                "at_pressure_pa": self.step.to,
-                "oil_capacitance_m3_per_pa": high.oil_capacitance_m3_per_pa,
-                "assumed_oil_capacitance_m3_per_pa": assumed_oil_capacitance_m3_per_pa,
-                "precharge_pa": high.precharge_pa,
-                "precharge_is_lower_bound": high.precharge_is_lower_bound,
-                "assumed_precharge_pa": assumed_precharge_pa,
-                "leakage_m3_per_s_pa": high.leakage_m3_per_s_pa,
-                "max_pressure_pa": high.max_pressure_pa,
-                "fit_percent": high.fit_percent,
-            }),
-        };
-        let parameters: serde_json::Map<String, Value> = self
-            .settings
-            .iter()
-            .map(|s| (s.id.name().to_string(), json!(s.value)))
-            .collect();
-        json!({
-            "loop": loop_name(self.loop_kind),
-            "step": {"from": self.step.from, "to": self.step.to, "t_s": self.step_time_s},
-            "target": {
-                "overshoot_percent": self.target.overshoot_percent,
-                "settling_s": self.target.settling_s,
-            },
-            "identified": identified,
-            "current_gains": {"kp": self.current_gains.kp, "ki": self.current_gains.ki},
-            "proposed_gains": {"kp": self.proposed_gains.kp, "ki": self.proposed_gains.ki},
-            "proposed_parameters": parameters,
-            "measured": metrics_json(&self.measured, &self.target),
-            "predicted": metrics_json(&self.predicted, &self.target),
-            "current_replayed": metrics_json(&self.replayed_current, &self.target),
-            "can_commands": commands,
-            "notes": self.notes,
-        })
-    }
+/// The shortest settling target: a millisecond is ten periods of the fastest outer loop. [s]
+pub const MIN_SETTLING_S: f64 = 1e-3;
 
-    /// The report printed on standard output.
-    pub fn to_text(&self, commands: &[String]) -> String {
-        let mut s = String::new();
-        let (unit, scale) = match self.loop_kind {
-            LoopKind::Speed => ("rad/s", 1.0),
-            LoopKind::Pressure => ("MPa", 1e-6),
-        };
-        let _ = writeln!(
-            s,
-            "{} loop: step {:.2} → {:.2} {unit} at {:.3} s",
-            loop_name(self.loop_kind),
-            self.step.from * scale,
-            self.step.to * scale,
-            self.step_time_s
-        );
-        match &self.identified {
-            Identified::Speed {
-                shaft,
-                assumed_inertia_kg_m2,
-                ..
-            } => {
-                let _ = writeln!(
-                    s,
-                    "identified: inertia {:.3e} kg·m² ({:.2}× the rig's {:.3e}), viscous {:.2e} \
-                     N·m·s, load {:.3} N·m; fit {:.1} %",
-                    shaft.inertia_kg_m2,
-                    shaft.inertia_kg_m2 / assumed_inertia_kg_m2,
-                    assumed_inertia_kg_m2,
-                    shaft.viscous_nm_s,
-                    shaft.load_nm,
-                    shaft.fit_percent
-                );
-            }
-            Identified::Pressure {
-                high,
-                assumed_precharge_pa,
-                capacitance_m3_per_pa,
-                assumed_capacitance_m3_per_pa,
-                ..
-            } => {
-                let _ = writeln!(
-                    s,
-                    "identified: capacitance at {:.2} MPa {:.3e} m³/Pa (the schedule assumes \
-                     {:.3e}, {:.1}×); oil {:.3e} m³/Pa, leakage {:.2e} (m³/s)/Pa, absorber \
-                     precharge {}{:.2} MPa (assumed {:.2} MPa); fit {:.1} %",
-                    self.step.to * 1e-6,
-                    capacitance_m3_per_pa,
-                    assumed_capacitance_m3_per_pa,
-                    assumed_capacitance_m3_per_pa / capacitance_m3_per_pa,
-                    high.oil_capacitance_m3_per_pa,
-                    high.leakage_m3_per_s_pa,
-                    if high.precharge_is_lower_bound {
-                        "> "
-                    } else {
-                        ""
-                    },
-                    high.precharge_pa * 1e-6,
-                    assumed_precharge_pa * 1e-6,
-                    high.fit_percent
-                );
-            }
-        }
-        let settle = |m: &StepMetrics| {
-            m.settling_s
-                .map_or("not settled".to_string(), |v| format!("{v:.3} s"))
-        };
-        let _ = writeln!(
-            s,
-            "{:<44} {:>11} {:>11} {:>10} {:>12}",
-            "", "kp", "ki", "overshoot", "settling"
-        );
-        let rows = [
-            (
-                "current gains, measured in the log",
-                self.current_gains,
-                &self.measured,
-            ),
-            (
-                "current gains, replayed on identified plant",
-                self.current_gains,
-                &self.replayed_current,
-            ),
-            (
-                "proposed gains, predicted",
-                self.proposed_gains,
-                &self.predicted,
-            ),
-        ];
-        for (name, g, m) in rows {
-            let _ = writeln!(
-                s,
-                "{name:<44} {:>11.4e} {:>11.4e} {:>8.1} % {:>12}",
-                g.kp,
-                g.ki,
-                m.overshoot_percent,
-                settle(m)
-            );
-        }
-        let _ = writeln!(
-            s,
-            "{:<44} {:>11} {:>11} {:>8.1} % {:>10.3} s",
-            "target (at most)", "", "", self.target.overshoot_percent, self.target.settling_s
-        );
-        for n in &self.notes {
-            let _ = writeln!(s, "note: {n}");
-        }
-        let _ = writeln!(s, "CAN commands (cansend, node {}):", can::NODE);
-        for c in commands {
-            let _ = writeln!(s, "  {c}");
-        }
-        s
+/// Checks the command line's target before the log is read.
+fn check_target(args: &TuneArgs) -> Result<(), CliError> {
+    if let Some(o) = args.overshoot.filter(|o| *o > 100.0) {
+        return Err(CliError::BadInput(format!(
+            "--overshoot {} %: an overshoot target lies between 0 and 100 %",
+            show(o)
+        )));
     }
-}
-
-fn loop_name(kind: LoopKind) -> &'static str {
-    match kind {
-        LoopKind::Speed => "speed",
-        LoopKind::Pressure => "pressure",
+    let most = MAX_SETTLING_S
+        .iter()
+        .find(|(k, _)| *k == args.loop_kind)
+        .map_or(10.0, |(_, s)| *s);
+    if let Some(s) = args
+        .settling
+        .filter(|s| !(MIN_SETTLING_S..=most).contains(s))
+    {
+        return Err(CliError::BadInput(format!(
+            "--settling {} s: the {} loop's settling target lies between {MIN_SETTLING_S} and \
+             {most} s",
+            show(s),
+            report::loop_name(args.loop_kind)
+        )));
     }
+    Ok(())
 }
 
 /// `eha tune`.
 pub fn run_tune(rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
+    check_target(args)?;
     let log = crate::bench_log::read(&args.log)?;
     let target = target_for(args.loop_kind, args.overshoot, args.settling);
-    let t = tune(rig, &log, args.loop_kind, target)?;
+    let busy = crate::output::progress::spinner(format!(
+        "tuning the {} loop from {}",
+        report::loop_name(args.loop_kind),
+        args.log.display()
+    ));
+    let t = tune(rig, &log, args.loop_kind, target);
+    busy.finish_and_clear();
+    let t = t?;
     let commands = can::command_lines(&t.settings).map_err(CliError::Failed)?;
     if let Some(path) = &args.json {
         write_json(path, &t.to_json(&commands))?;

@@ -413,11 +413,13 @@ fn accumulator_design_writes_json_file_and_prints_the_table() {
         assert!(v[key].is_number(), "{key}");
     }
     assert_eq!(fs::read_dir(&dir).unwrap().count(), 1, "no temporary left");
-    // An unwritable destination is a failure (1), not bad input.
+    // A destination in a folder that does not exist is a bad argument, found before the
+    // run (2), naming the folder.
     let o = eha(&[
         "accumulator-design",
         "--json",
         s(&dir.join("no/such/dir/x.json")),
     ]);
-    assert_eq!(status(&o), 1, "{}", stderr(&o));
+    assert_eq!(status(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("no/such/dir"), "{}", stderr(&o));
 }

@@ -9,11 +9,10 @@ mod common;
 
 use common::{eha, s};
 use host_sim::bench_log::{self, BenchLog};
-use host_sim::cli::LoopKind;
 use host_sim::rig_file;
 use host_sim::run::{run, RunOptions};
 use host_sim::tune::step::Target;
-use host_sim::tune::{self, predict, Identified, Tuning, PRESSURE_TARGET, SPEED_TARGET};
+use host_sim::tune::{self, predict, Identified, LoopKind, Tuning, PRESSURE_TARGET, SPEED_TARGET};
 use plant_model::Rig;
 use std::fs;
 use std::path::PathBuf;

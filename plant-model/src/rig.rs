@@ -454,22 +454,40 @@ impl Rig {
     /// Checks every parameter once; the plant is only built from a rig that passes.
     pub fn validate(&self) -> Result<(), RigError> {
         let m = &self.motor;
-        positive_int("motor.pole_pairs", m.pole_pairs)?;
-        positive("motor.r_s_ohm", m.r_s_ohm)?;
-        positive("motor.l_d_h", m.l_d_h)?;
-        positive("motor.l_q_h", m.l_q_h)?;
-        positive("motor.psi_f_wb", m.psi_f_wb)?;
-        positive_int("motor.stator_slots", m.stator_slots)?;
+        count("motor.pole_pairs", m.pole_pairs, 64)?;
+        within!("motor.r_s_ohm", m.r_s_ohm, 1e-4, 1e3, "Ω")?;
+        within!("motor.l_d_h", m.l_d_h, 1e-6, 10.0, "H")?;
+        within!("motor.l_q_h", m.l_q_h, 1e-6, 10.0, "H")?;
+        within!("motor.psi_f_wb", m.psi_f_wb, 1e-4, 10.0, "Wb")?;
+        count("motor.stator_slots", m.stator_slots, 1024)?;
         for c in &m.cogging {
-            non_negative("motor.cogging.amplitude_nm", c.amplitude_nm)?;
-            finite("motor.cogging.phase_rad", c.phase_rad)?;
+            within!(
+                "motor.cogging.amplitude_nm",
+                c.amplitude_nm,
+                0.0,
+                1e3,
+                "N·m"
+            )?;
+            within!("motor.cogging.phase_rad", c.phase_rad, -1e3, 1e3, "rad")?;
             if c.amplitude_nm > 0.0 && c.order == 0 {
                 return Err(RigError::new("motor.cogging.order", "must be at least 1"));
             }
         }
         for h in &m.flux_harmonics {
-            finite("motor.flux_harmonics.amplitude_wb", h.amplitude_wb)?;
-            finite("motor.flux_harmonics.phase_rad", h.phase_rad)?;
+            within!(
+                "motor.flux_harmonics.amplitude_wb",
+                h.amplitude_wb,
+                -10.0,
+                10.0,
+                "Wb"
+            )?;
+            within!(
+                "motor.flux_harmonics.phase_rad",
+                h.phase_rad,
+                -1e3,
+                1e3,
+                "rad"
+            )?;
             if h.amplitude_wb != 0.0 && (h.order < 5 || h.order % 6 != 1 && h.order % 6 != 5) {
                 return Err(RigError::new(
                     "motor.flux_harmonics.order",
@@ -478,63 +496,153 @@ impl Rig {
             }
         }
         let i = &self.inverter;
-        positive("inverter.u_dc_v", i.u_dc_v)?;
-        positive("inverter.pwm_frequency_hz", i.pwm_frequency_hz)?;
-        non_negative("inverter.dead_time_s", i.dead_time_s)?;
+        within!("inverter.u_dc_v", i.u_dc_v, 1.0, 1e4, "V")?;
+        within!(
+            "inverter.pwm_frequency_hz",
+            i.pwm_frequency_hz,
+            1e3,
+            1e6,
+            "Hz"
+        )?;
+        within!("inverter.dead_time_s", i.dead_time_s, 0.0, 1e-4, "s")?;
         if i.dead_time_s * i.pwm_frequency_hz >= 0.25 {
             return Err(RigError::new(
                 "inverter.dead_time_s",
                 "must be under a quarter of the PWM period",
             ));
         }
-        positive(
+        within!(
             "inverter.dead_time_current_band_a",
             i.dead_time_current_band_a,
+            1e-6,
+            1e3,
+            "A"
         )?;
         let s = &self.shaft;
-        positive("shaft.motor_inertia_kg_m2", s.motor_inertia_kg_m2)?;
-        non_negative("shaft.pump_inertia_kg_m2", s.pump_inertia_kg_m2)?;
-        non_negative("shaft.viscous_nm_s", s.viscous_nm_s)?;
-        non_negative("shaft.coulomb_nm", s.coulomb_nm)?;
-        non_negative("shaft.static_nm", s.static_nm)?;
+        within!(
+            "shaft.motor_inertia_kg_m2",
+            s.motor_inertia_kg_m2,
+            1e-7,
+            10.0,
+            "kg·m²"
+        )?;
+        within!(
+            "shaft.pump_inertia_kg_m2",
+            s.pump_inertia_kg_m2,
+            0.0,
+            10.0,
+            "kg·m²"
+        )?;
+        within!("shaft.viscous_nm_s", s.viscous_nm_s, 0.0, 1e2, "N·m·s")?;
+        within!("shaft.coulomb_nm", s.coulomb_nm, 0.0, 1e3, "N·m")?;
+        within!("shaft.static_nm", s.static_nm, 0.0, 1e3, "N·m")?;
         let p = &self.pump;
-        positive("pump.displacement_m3_per_rev", p.displacement_m3_per_rev)?;
+        within!(
+            "pump.displacement_m3_per_rev",
+            p.displacement_m3_per_rev,
+            1e-8,
+            1e-3,
+            "m³"
+        )?;
         if p.pistons < 3 || p.pistons as usize > crate::pump::MAX_PISTONS {
             return Err(RigError::new("pump.pistons", "must be 3 to 31"));
         }
-        non_negative("pump.ripple_amplitude_ratio", p.ripple_amplitude_ratio)?;
-        if p.ripple_amplitude_ratio >= 1.0 {
-            return Err(RigError::new(
-                "pump.ripple_amplitude_ratio",
-                "must be below 1 (peak-to-peak over mean flow)",
-            ));
-        }
-        non_negative("pump.internal_leakage_m3_s_pa", p.internal_leakage_m3_s_pa)?;
-        non_negative("pump.external_leakage_m3_s_pa", p.external_leakage_m3_s_pa)?;
-        non_negative("pump.extra_leakage_m3_s_pa", p.extra_leakage_m3_s_pa)?;
+        within!(
+            "pump.ripple_amplitude_ratio",
+            p.ripple_amplitude_ratio,
+            0.0,
+            0.99,
+            "(peak-to-peak over mean flow)"
+        )?;
+        within!(
+            "pump.internal_leakage_m3_s_pa",
+            p.internal_leakage_m3_s_pa,
+            0.0,
+            1e-9,
+            "(m³/s)/Pa"
+        )?;
+        within!(
+            "pump.external_leakage_m3_s_pa",
+            p.external_leakage_m3_s_pa,
+            0.0,
+            1e-9,
+            "(m³/s)/Pa"
+        )?;
+        within!(
+            "pump.extra_leakage_m3_s_pa",
+            p.extra_leakage_m3_s_pa,
+            0.0,
+            1e-9,
+            "(m³/s)/Pa"
+        )?;
         let c = &self.cylinder;
-        positive("cylinder.area_m2", c.area_m2)?;
-        positive("cylinder.chamber_a_volume_m3", c.chamber_a_volume_m3)?;
-        positive("cylinder.chamber_b_volume_m3", c.chamber_b_volume_m3)?;
-        non_negative(
+        within!("cylinder.area_m2", c.area_m2, 1e-6, 1.0, "m²")?;
+        within!(
+            "cylinder.chamber_a_volume_m3",
+            c.chamber_a_volume_m3,
+            1e-7,
+            1.0,
+            "m³"
+        )?;
+        within!(
+            "cylinder.chamber_b_volume_m3",
+            c.chamber_b_volume_m3,
+            1e-7,
+            1.0,
+            "m³"
+        )?;
+        within!(
             "cylinder.internal_leakage_m3_s_pa",
             c.internal_leakage_m3_s_pa,
+            0.0,
+            1e-9,
+            "(m³/s)/Pa"
         )?;
-        non_negative("cylinder.viscous_n_s_per_m", c.viscous_n_s_per_m)?;
-        non_negative("cylinder.static_friction_n", c.static_friction_n)?;
-        non_negative("cylinder.coulomb_friction_n", c.coulomb_friction_n)?;
-        positive("cylinder.mass_kg", c.mass_kg)?;
-        positive("cylinder.half_stroke_m", c.half_stroke_m)?;
-        positive(
+        within!(
+            "cylinder.viscous_n_s_per_m",
+            c.viscous_n_s_per_m,
+            0.0,
+            1e8,
+            "N·s/m"
+        )?;
+        within!(
+            "cylinder.static_friction_n",
+            c.static_friction_n,
+            0.0,
+            1e7,
+            "N"
+        )?;
+        within!(
+            "cylinder.coulomb_friction_n",
+            c.coulomb_friction_n,
+            0.0,
+            1e7,
+            "N"
+        )?;
+        within!("cylinder.mass_kg", c.mass_kg, 1e-3, 1e6, "kg")?;
+        within!("cylinder.half_stroke_m", c.half_stroke_m, 1e-4, 10.0, "m")?;
+        within!(
             "cylinder.end_stop_stiffness_n_per_m",
             c.end_stop_stiffness_n_per_m,
+            1e3,
+            1e12,
+            "N/m"
         )?;
-        non_negative(
+        within!(
             "cylinder.end_stop_damping_n_s_per_m",
             c.end_stop_damping_n_s_per_m,
+            0.0,
+            1e9,
+            "N·s/m"
         )?;
-        non_negative("cylinder.spring_n_per_m", c.spring_n_per_m)?;
-        finite("cylinder.gravity_angle_rad", c.gravity_angle_rad)?;
+        within!("cylinder.spring_n_per_m", c.spring_n_per_m, 0.0, 1e9, "N/m")?;
+        within!(
+            "cylinder.gravity_angle_rad",
+            c.gravity_angle_rad,
+            -1e3,
+            1e3,
+            "rad"
+        )?;
         // The swept volume must leave oil in each chamber at the end stops.
         let swept = c.area_m2 * c.half_stroke_m;
         if swept >= c.chamber_a_volume_m3 {
@@ -549,77 +657,140 @@ impl Rig {
                 "must exceed area × half stroke (the chamber would vanish at the end stop)",
             ));
         }
-        positive("oil.bulk_modulus_pa", self.oil.bulk_modulus_pa)?;
-        positive("oil.density_kg_m3", self.oil.density_kg_m3)?;
+        within!(
+            "oil.bulk_modulus_pa",
+            self.oil.bulk_modulus_pa,
+            1e6,
+            1e11,
+            "Pa"
+        )?;
+        within!(
+            "oil.density_kg_m3",
+            self.oil.density_kg_m3,
+            1e2,
+            1e4,
+            "kg/m³"
+        )?;
         let a = &self.absorber;
-        positive("absorber.shell_volume_m3", a.shell_volume_m3)?;
-        positive("absorber.precharge_pa", a.precharge_pa)?;
+        within!(
+            "absorber.shell_volume_m3",
+            a.shell_volume_m3,
+            1e-6,
+            1.0,
+            "m³"
+        )?;
+        within!("absorber.precharge_pa", a.precharge_pa, 1e3, 1e8, "Pa")?;
         polytropic("absorber.polytropic_exponent", a.polytropic_exponent)?;
-        positive("absorber.inlet_inertance_kg_m4", a.inlet_inertance_kg_m4)?;
-        non_negative(
+        within!(
+            "absorber.inlet_inertance_kg_m4",
+            a.inlet_inertance_kg_m4,
+            1.0,
+            1e12,
+            "kg/m⁴"
+        )?;
+        within!(
             "absorber.inlet_resistance_pa_s_m3",
             a.inlet_resistance_pa_s_m3,
+            0.0,
+            1e13,
+            "Pa·s/m³"
         )?;
         let f = &self.fill;
-        positive("fill.pressure_pa", f.pressure_pa)?;
-        positive("fill.precharge_pa", f.precharge_pa)?;
+        within!("fill.pressure_pa", f.pressure_pa, 1e3, 1e8, "Pa")?;
+        within!("fill.precharge_pa", f.precharge_pa, 1e3, 1e8, "Pa")?;
         if f.precharge_pa >= f.pressure_pa {
             return Err(RigError::new(
                 "fill.precharge_pa",
                 "must be below fill.pressure_pa (the fill accumulator must hold oil)",
             ));
         }
-        positive("fill.shell_volume_m3", f.shell_volume_m3)?;
+        within!("fill.shell_volume_m3", f.shell_volume_m3, 1e-6, 1.0, "m³")?;
         polytropic("fill.polytropic_exponent", f.polytropic_exponent)?;
-        non_negative("fill.check_cracking_pa", f.check_cracking_pa)?;
-        positive(
+        within!(
+            "fill.check_cracking_pa",
+            f.check_cracking_pa,
+            0.0,
+            1e7,
+            "Pa"
+        )?;
+        within!(
             "fill.check_conductance_m3_s_pa",
             f.check_conductance_m3_s_pa,
+            1e-15,
+            1e-3,
+            "(m³/s)/Pa"
         )?;
-        positive("fill.relief_cracking_pa", f.relief_cracking_pa)?;
-        positive(
+        within!(
+            "fill.relief_cracking_pa",
+            f.relief_cracking_pa,
+            1e4,
+            2e8,
+            "Pa"
+        )?;
+        within!(
             "fill.relief_conductance_m3_s_pa",
             f.relief_conductance_m3_s_pa,
+            1e-15,
+            1e-3,
+            "(m³/s)/Pa"
         )?;
         let cs = &self.sensors.current;
-        positive("sensors.current.a_per_lsb", cs.a_per_lsb)?;
+        within!("sensors.current.a_per_lsb", cs.a_per_lsb, 1e-6, 10.0, "A")?;
         adc_bits("sensors.current.bits", cs.bits)?;
         in_adc_range("sensors.current.zero_lsb", cs.zero_lsb, cs.bits)?;
         for o in &cs.offset_a {
-            finite("sensors.current.offset_a", *o)?;
+            within!("sensors.current.offset_a", *o, -1e3, 1e3, "A")?;
         }
-        non_negative("sensors.current.noise_a_rms", cs.noise_a_rms)?;
+        within!("sensors.current.noise_a_rms", cs.noise_a_rms, 0.0, 1e2, "A")?;
         let ps = &self.sensors.pressure;
-        positive("sensors.pressure.pa_per_lsb", ps.pa_per_lsb)?;
+        within!(
+            "sensors.pressure.pa_per_lsb",
+            ps.pa_per_lsb,
+            1e-3,
+            1e6,
+            "Pa"
+        )?;
         adc_bits("sensors.pressure.bits", ps.bits)?;
         in_adc_range("sensors.pressure.zero_lsb", ps.zero_lsb, ps.bits)?;
-        finite("sensors.pressure.offset_pa", ps.offset_pa)?;
-        non_negative("sensors.pressure.noise_pa_rms", ps.noise_pa_rms)?;
-        non_negative(
+        within!("sensors.pressure.offset_pa", ps.offset_pa, -1e8, 1e8, "Pa")?;
+        within!(
+            "sensors.pressure.noise_pa_rms",
+            ps.noise_pa_rms,
+            0.0,
+            1e8,
+            "Pa"
+        )?;
+        within!(
             "sensors.pressure.lag_time_constant_s",
             ps.lag_time_constant_s,
+            0.0,
+            10.0,
+            "s"
         )?;
         let vs = &self.sensors.dc_link;
-        positive("sensors.dc_link.v_per_lsb", vs.v_per_lsb)?;
+        within!("sensors.dc_link.v_per_lsb", vs.v_per_lsb, 1e-4, 10.0, "V")?;
         adc_bits("sensors.dc_link.bits", vs.bits)?;
-        non_negative("sensors.dc_link.noise_v_rms", vs.noise_v_rms)?;
-        if self.sensors.encoder.counts_per_rev < 4 {
+        within!("sensors.dc_link.noise_v_rms", vs.noise_v_rms, 0.0, 1e3, "V")?;
+        if !(4..=1 << 24).contains(&self.sensors.encoder.counts_per_rev) {
             return Err(RigError::new(
                 "sensors.encoder.counts_per_rev",
-                "must be at least 4",
+                "must lie between 4 and 16777216",
             ));
         }
-        finite(
+        within!(
             "sensors.encoder.offset_rad",
             self.sensors.encoder.offset_rad,
+            -1e3,
+            1e3,
+            "rad"
         )?;
-        positive("integration.max_step_s", self.integration.max_step_s)?;
-        if self.integration.max_step_s > 1e-3 {
-            return Err(RigError::new(
-                "integration.max_step_s",
-                "must be at most 1 ms (RK4 stability on the check-valve and electrical states)",
-            ));
-        }
+        within!(
+            "integration.max_step_s",
+            self.integration.max_step_s,
+            1e-6,
+            1e-3,
+            "s"
+        )?;
         Ok(())
     }
 }
@@ -649,29 +820,58 @@ impl core::fmt::Display for RigError {
 #[cfg(feature = "std")]
 impl std::error::Error for RigError {}
 
+/// Checks that `$v` is finite and within `[$lo, $hi]` (SI units `$unit`), the reason naming
+/// the range: wide enough for any actuator of this kind, narrow enough that the model's
+/// integration stays finite and its cost bounded.
+macro_rules! within {
+    ($name:expr, $v:expr, $lo:literal, $hi:literal, $unit:literal) => {
+        in_range(
+            $name,
+            $v,
+            $lo,
+            $hi,
+            concat!(
+                "must lie between ",
+                stringify!($lo),
+                " and ",
+                stringify!($hi),
+                " ",
+                $unit
+            ),
+        )
+    };
+}
+use within;
+
+fn in_range(
+    name: &'static str,
+    v: f64,
+    lo: f64,
+    hi: f64,
+    reason: &'static str,
+) -> Result<(), RigError> {
+    finite(name, v)?;
+    if (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(RigError::new(name, reason))
+    }
+}
+
+fn count(name: &'static str, v: u32, most: u32) -> Result<(), RigError> {
+    positive_int(name, v)?;
+    if v <= most {
+        Ok(())
+    } else {
+        Err(RigError::new(name, "is beyond any motor of this kind"))
+    }
+}
+
 fn finite(name: &'static str, v: f64) -> Result<(), RigError> {
     if v.is_finite() {
         Ok(())
     } else {
         Err(RigError::new(name, "must be a finite number"))
-    }
-}
-
-fn positive(name: &'static str, v: f64) -> Result<(), RigError> {
-    finite(name, v)?;
-    if v > 0.0 {
-        Ok(())
-    } else {
-        Err(RigError::new(name, "must be positive"))
-    }
-}
-
-fn non_negative(name: &'static str, v: f64) -> Result<(), RigError> {
-    finite(name, v)?;
-    if v >= 0.0 {
-        Ok(())
-    } else {
-        Err(RigError::new(name, "must not be negative"))
     }
 }
 
@@ -773,5 +973,29 @@ mod tests {
         let mut r = Rig::nominal();
         r.absorber.precharge_pa = f64::INFINITY;
         assert_eq!(r.validate().unwrap_err().parameter, "absorber.precharge_pa");
+    }
+
+    #[test]
+    fn values_beyond_any_actuator_are_named() {
+        // A step far below a microsecond makes a simulated second cost millions of steps.
+        for step in [1e-30, 1e-9] {
+            let mut r = Rig::nominal();
+            r.integration.max_step_s = step;
+            let e = r.validate().unwrap_err();
+            assert_eq!(e.parameter, "integration.max_step_s");
+            assert!(e.reason.contains("1e-6"), "{}", e.reason);
+        }
+        let mut r = Rig::nominal();
+        r.absorber.precharge_pa = 1e30;
+        assert_eq!(r.validate().unwrap_err().parameter, "absorber.precharge_pa");
+        let mut r = Rig::nominal();
+        r.cylinder.mass_kg = 1e30;
+        assert_eq!(r.validate().unwrap_err().parameter, "cylinder.mass_kg");
+        let mut r = Rig::nominal();
+        r.motor.cogging[0].phase_rad = -1e30;
+        assert_eq!(
+            r.validate().unwrap_err().parameter,
+            "motor.cogging.phase_rad"
+        );
     }
 }

@@ -313,6 +313,21 @@ fn a_record_written_to_the_documented_layout_loads() {
     assert_eq!(&mem[..SPAN], &rec1[..]);
 }
 
+#[test]
+fn the_save_after_the_last_sequence_number_wins() {
+    // Found by fuzzing: a record at sequence u32::MAX; the save after it wraps to 0 and
+    // used to lose to it ("newer = larger"), so the saved table vanished at the next boot.
+    let old = table(3.0);
+    let rec = documented_record(1, parameters::LAYOUT_FINGERPRINT, u32::MAX, &old);
+    let mut s = store(flash_with(&rec));
+    let new = table(4.0);
+    assert_eq!(s.save(&new), Ok(0));
+    assert_eq!(s.load(), (Some(new), LoadOutcome::Loaded { sequence: 0 }));
+    let newer = table(5.0);
+    assert_eq!(s.save(&newer), Ok(1));
+    assert_eq!(s.load(), (Some(newer), LoadOutcome::Loaded { sequence: 1 }));
+}
+
 fn boots_to_defaults_with_fault(flash: CutFlash, want: LoadOutcome) {
     let mut s = store(flash);
     let (cfg, outcome) = boot_config(&mut s, &Config::nominal());

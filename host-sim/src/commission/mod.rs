@@ -7,7 +7,10 @@
 
 pub mod margins;
 
-use crate::cli::{print_stdout, write_json, CliError, CommissionArgs};
+use crate::output::paths::Declared;
+use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::values::{positive_f64, show};
+use clap::Args;
 use closed_loop::commissioning::{commission, nameplate_config};
 use firmware::commissioning::CommissioningResult;
 use margins::{current_loop, margins, speed_loop, Margins, SpeedPlant};
@@ -15,6 +18,25 @@ use plant_model::Rig;
 use serde_json::json;
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// `eha commission`.
+#[derive(Debug, Args)]
+pub struct CommissionArgs {
+    /// Current-loop bandwidth to design for. [rad/s]
+    #[arg(long, value_name = "RAD_S", default_value = "1100", value_parser = positive_f64, allow_negative_numbers = true)]
+    pub bandwidth: f64,
+    /// Write the results as JSON (`-`: standard output).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+impl CommissionArgs {
+    /// The files it writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default().file("--json", self.json.as_ref())
+    }
+}
 
 /// Seed of the sensor noise (a fixed seed: the same rig gives the same report).
 pub const SEED: u64 = 1;
@@ -237,10 +259,24 @@ impl Report {
 /// `eha commission`.
 pub fn run_commission(rig: &Rig, args: &CommissionArgs) -> Result<(), CliError> {
     let mut config = nameplate_config(rig);
+    // The firmware's bounds on the bandwidth, said in the user's terms before its own
+    // validation (which names configuration fields).
+    let pwm_hz = config.rates.pwm_hz as f64;
+    let most = 0.1 * TAU * pwm_hz;
+    let speed_wn = config.commissioning.speed_natural_frequency_rad_s as f64;
+    let least = 4.0 * speed_wn;
+    if !(least..=most).contains(&args.bandwidth) {
+        return Err(CliError::BadInput(format!(
+            "--bandwidth {} rad/s: the current loop's bandwidth must lie between {least:.0} \
+             rad/s (4× the speed loop's {speed_wn:.1} rad/s natural frequency) and {most:.0} rad/s \
+             (a tenth of the {pwm_hz} Hz PWM frequency)",
+            show(args.bandwidth)
+        )));
+    }
     config.commissioning.current_bandwidth_rad_s = args.bandwidth as f32;
     config
         .validate()
-        .map_err(|e| CliError::BadInput(format!("--bandwidth {}: {e}", args.bandwidth)))?;
+        .map_err(|e| CliError::BadInput(format!("--bandwidth {}: {e}", show(args.bandwidth))))?;
     let outcome = commission(rig, &config, SEED).map_err(|e| CliError::BadInput(e.to_string()))?;
     let result = match (outcome.result, outcome.fault) {
         (Some(r), None) => r,
@@ -266,7 +302,7 @@ pub fn run_commission(rig: &Rig, args: &CommissionArgs) -> Result<(), CliError> 
     );
     if let Some(path) = &args.json {
         write_json(path, &report.to_json())?;
-        if crate::cli::is_stdout(path) {
+        if is_stdout(path) {
             return Ok(());
         }
     }

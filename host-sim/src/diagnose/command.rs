@@ -2,13 +2,73 @@
 //! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
 use super::analysis::analyse;
-use crate::cli::{print_stdout, write_json, CliError, DiagnoseArgs};
+use super::DiagnoseError;
+use crate::output::paths::Declared;
+use crate::output::{print_stdout, write_json, CliError};
+use clap::Args;
 use plant_model::Rig;
+use std::path::PathBuf;
+
+/// `eha diagnose`.
+#[derive(Debug, Args)]
+pub struct DiagnoseArgs {
+    /// Bench log to explain.
+    #[arg(value_name = "LOG.csv")]
+    pub log: PathBuf,
+    /// Write the results as JSON (`-`: standard output).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+    /// Folder for the report (plots and text).
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+}
+
+impl DiagnoseArgs {
+    /// The files it reads and writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default()
+            .input("LOG", Some(&self.log))
+            .file("--json", self.json.as_ref())
+            .dir("--report", self.report.as_ref())
+    }
+}
+
+/// A diagnosis error as the command reports it: what the log holds is bad input (exit 2),
+/// naming the log's columns rather than the replay's internal state.
+fn input_or_failure(e: DiagnoseError, log: &std::path::Path) -> CliError {
+    match e {
+        DiagnoseError::Log(e) => CliError::BenchLog(e),
+        DiagnoseError::Rig(e) => {
+            let column = match e.parameter {
+                "initial.p_a_pa" => "p_pa",
+                "initial.p_b_pa" => "p_low_pa",
+                "initial.x_m" => "x_m",
+                "initial.omega_rad_s" => "speed_rad_s (or theta_m_rad)",
+                "initial.theta_m_rad" => "theta_m_rad",
+                _ => return CliError::BadInput(format!("the rig cannot be replayed: {e}")),
+            };
+            CliError::BadInput(format!(
+                "bench log `{}`: the first rows' {column} give the replay a start the rig \
+                 cannot take ({}): is the log of this rig (--rig), in SI units?",
+                log.display(),
+                e.reason
+            ))
+        }
+    }
+}
 
 /// `eha diagnose`.
 pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
     let log = crate::bench_log::read(&args.log)?;
-    let analysis = analyse(&log, rig).map_err(|e| CliError::Failed(e.to_string()))?;
+    crate::bench_log::replayable::check(&log, rig, &args.log)?;
+    let busy = crate::output::progress::spinner(format!(
+        "diagnosing {} ({} rows)",
+        args.log.display(),
+        log.len()
+    ));
+    let analysis = analyse(&log, rig);
+    busy.finish_and_clear();
+    let analysis = analysis.map_err(|e| input_or_failure(e, &args.log))?;
     let d = &analysis.diagnosis;
     let mut text = String::new();
     text.push_str(&format!(

@@ -6,7 +6,7 @@
 //! of them are written, so a failure leaves DIR as it was.
 
 use super::analysis::Analysis;
-use crate::cli::CliError;
+use crate::output::CliError;
 use crate::plots::{line_chart, Marker, Series};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -39,7 +39,8 @@ pub fn write_report(dir: &Path, log_path: &Path, analysis: &Analysis) -> Result<
         .map_or("report".into(), |n| n.to_string_lossy().to_string());
     let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&staging);
-    std::fs::create_dir_all(&staging).map_err(|e| failed(&staging.display().to_string(), e))?;
+    std::fs::create_dir_all(&staging).map_err(|e| failed(&dir.display().to_string(), e))?;
+    let _cleanup = crate::output::interrupt::remove_on_interrupt(&staging);
     let result = render(&staging, log_path, analysis).and_then(|files| {
         std::fs::create_dir_all(dir).map_err(|e| failed(&dir.display().to_string(), e))?;
         for f in files {
@@ -219,7 +220,7 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
         let _ = writeln!(md, "![{s} residual spectrum]({file})\n");
         files.push(file);
     }
-    crate::atomic_file::write(&dir.join("report.md"), md.as_bytes())
+    crate::output::atomic::write(&dir.join("report.md"), md.as_bytes())
         .map_err(|e| failed("report.md", e))?;
     files.push("report.md".into());
     Ok(files)

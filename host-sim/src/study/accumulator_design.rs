@@ -99,6 +99,14 @@ pub enum DesignError {
         /// Rig's fill pressure. [Pa]
         fill_pa: f64,
     },
+    /// The working pressure reaches the relief valve: the pump cannot hold it.
+    #[error("working pressure {working_pa:e} Pa must be below the relief valve's cracking pressure {relief_pa:e} Pa (fill.relief_cracking_pa): the valve opens before it is reached")]
+    PressureAboveRelief {
+        /// Asked working pressure. [Pa]
+        working_pa: f64,
+        /// Rig's relief cracking pressure. [Pa]
+        relief_pa: f64,
+    },
 }
 
 /// Pulsation orders of the pump's kinematic flow ripple per shaft revolution: 2·z for an
@@ -194,6 +202,12 @@ pub fn design(rig: &Rig, working_pa: f64) -> Result<AccumulatorDesign, DesignErr
         return Err(DesignError::PressureBelowFill {
             working_pa,
             fill_pa,
+        });
+    }
+    if working_pa >= rig.fill.relief_cracking_pa {
+        return Err(DesignError::PressureAboveRelief {
+            working_pa,
+            relief_pa: rig.fill.relief_cracking_pa,
         });
     }
     let a = &rig.absorber;

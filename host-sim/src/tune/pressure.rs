@@ -257,6 +257,14 @@ pub fn gains_at(config: &Config, p: f64) -> Gains {
 pub fn identified_rig(rig: &Rig, high: &HighSide) -> Rig {
     let mut r = rig.clone();
     r.cylinder.chamber_a_volume_m3 = high.oil_capacitance_m3_per_pa * rig.oil.bulk_modulus_pa;
+    // The identification and the step's replay hold the piston blocked at mid-stroke, where
+    // the stroke does not matter; an oil volume below the half-stroke's swept volume is kept
+    // simulatable by a shorter stroke (the model refuses a chamber that would vanish at its
+    // end stop).
+    let half_stroke_fits = 0.5 * r.cylinder.chamber_a_volume_m3 / r.cylinder.area_m2;
+    if r.cylinder.half_stroke_m >= half_stroke_fits {
+        r.cylinder.half_stroke_m = half_stroke_fits;
+    }
     r.absorber.precharge_pa = high.precharge_pa;
     let g0 = rig.pump.internal_leakage_m3_s_pa
         + rig.pump.external_leakage_m3_s_pa

@@ -10,10 +10,18 @@
 //! naming the file, the line and the column. Columns the contract does not know are skipped
 //! unread (a rig's logger may add a text column); unknown metadata keys are kept.
 //!
+//! Beyond the contract, for bounded memory and arithmetic: a line longer than
+//! [`limits::MAX_LINE_BYTES`], more than [`limits::MAX_ROWS`] rows, or a value outside its
+//! column's physical range ([`limits::physical_range`]) is refused the same way.
+//!
 //! The writer checks the same rules first (so every file it writes reads back), writes the
 //! values in shortest round-trip notation and replaces the target atomically
-//! ([`crate::atomic_file`]): a failed write leaves no partial file.
+//! ([`crate::output::atomic`]): a failed write leaves no partial file.
 
+pub mod limits;
+pub mod replayable;
+
+use limits::{excerpt, line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS};
 use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Write};
@@ -288,6 +296,16 @@ impl BenchLog {
                     },
                 ));
             }
+            if let Some(i) = c.iter().position(|v| out_of_range(s, *v)) {
+                return Err(content(header_line + 1 + i, s.name(), beyond(s, c[i])));
+            }
+        }
+        if rows > MAX_ROWS {
+            return Err(content(
+                header_line + 1 + MAX_ROWS,
+                Signal::Time.name(),
+                Problem::TooManyRows,
+            ));
         }
         if let Some(i) = self.t_s.windows(2).position(|w| w[1] <= w[0]) {
             return Err(content(
@@ -330,9 +348,33 @@ pub enum Problem {
     /// A field of a known column is not a finite number.
     #[error("`{text}` is not a finite number")]
     NotANumber {
-        /// The field as written.
+        /// The field as written (an excerpt of a long one).
         text: String,
     },
+    /// A field of a known column is empty.
+    #[error("the field is empty; a number is required")]
+    EmptyField,
+    /// A value outside its column's physical range.
+    #[error("{value:e} {unit} lies outside the physical range {low:e} to {high:e} {unit}")]
+    OutOfRange {
+        /// The value.
+        value: f64,
+        /// The range's low end.
+        low: f64,
+        /// The range's high end.
+        high: f64,
+        /// Its unit.
+        unit: &'static str,
+    },
+    /// More rows than a bench log may have.
+    #[error("more than {MAX_ROWS} data rows; split the log")]
+    TooManyRows,
+    /// A line longer than a bench log's longest.
+    #[error("line longer than {MAX_LINE_BYTES} bytes (not a bench log, or a binary file?)")]
+    LineTooLong,
+    /// A line that is not UTF-8 text.
+    #[error("not UTF-8 text (a binary file?)")]
+    NotUtf8,
     /// Time does not strictly increase.
     #[error("time {value} s does not exceed the previous row's {previous} s")]
     TimeNotIncreasing {
@@ -355,7 +397,7 @@ pub enum Problem {
         /// Fields in this row.
         found: usize,
     },
-    /// The line is not valid UTF-8 or not valid CSV.
+    /// The line is not valid CSV.
     #[error("malformed line: {0}")]
     Malformed(String),
     /// Writing: a column's length differs from the time column's.
@@ -376,7 +418,7 @@ pub enum Problem {
 #[derive(Debug, thiserror::Error)]
 pub enum BenchLogError {
     /// The file cannot be opened or read.
-    #[error("bench log `{}`: {source}", file.display())]
+    #[error("bench log `{}`: {}", file.display(), crate::output::paths::describe(source))]
     Read {
         /// The file.
         file: PathBuf,
@@ -392,7 +434,7 @@ pub enum BenchLogError {
         source: io::Error,
     },
     /// The content breaks the contract.
-    #[error("bench log `{}`, line {line}, column `{column}`: {problem}", file.display())]
+    #[error("bench log `{}`, line {line}{}: {problem}", file.display(), column_part(column))]
     Content {
         /// The file.
         file: PathBuf,
@@ -403,6 +445,29 @@ pub enum BenchLogError {
         /// What is wrong.
         problem: Problem,
     },
+    /// Readable, but not replayable on the rig (see [`replayable`]).
+    #[error("bench log `{}`, data row {}, t = {t_s} s, column `{column}`: {why}", file.display(), row + 1)]
+    Replay {
+        /// The file.
+        file: PathBuf,
+        /// 0-based data row.
+        row: usize,
+        /// Its time. [s]
+        t_s: f64,
+        /// The column.
+        column: String,
+        /// Why.
+        why: String,
+    },
+}
+
+/// `, column `name`` unless the error sits on no column.
+fn column_part(column: &str) -> String {
+    if column.is_empty() {
+        String::new()
+    } else {
+        format!(", column `{column}`")
+    }
 }
 
 impl BenchLogError {
@@ -419,6 +484,9 @@ pub fn read(path: &Path) -> Result<BenchLog, BenchLogError> {
         file: path.to_path_buf(),
         source,
     };
+    if let Some(why) = crate::output::paths::input_problem(path) {
+        return Err(io_err(io::Error::new(io::ErrorKind::InvalidInput, why)));
+    }
     let file = File::open(path).map_err(io_err)?;
     parse(BufReader::new(file), path)
 }
@@ -428,14 +496,14 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     let err = |line: usize, column: &str, problem: Problem| BenchLogError::Content {
         file: path.to_path_buf(),
         line,
-        column: column.to_string(),
+        column: excerpt(column),
         problem,
     };
     let io_err = |source| BenchLogError::Read {
         file: path.to_path_buf(),
         source,
     };
-    let mut input = BufReader::new(input);
+    let mut input = BufReader::new(LineLimited::new(input));
     let mut log = BenchLog::default();
 
     // Metadata and blank lines before the header; the CSV reader takes over at the first
@@ -452,8 +520,10 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
         }
         line.clear();
         input.read_line(&mut line).map_err(|e| {
-            if e.kind() == io::ErrorKind::InvalidData {
-                err(consumed + 1, "", Problem::Malformed("not UTF-8".into()))
+            if let Some(l) = line_too_long(&e) {
+                err(l, "", Problem::LineTooLong)
+            } else if e.kind() == io::ErrorKind::InvalidData {
+                err(consumed + 1, "", Problem::NotUtf8)
             } else {
                 io_err(e)
             }
@@ -482,8 +552,12 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
             .position()
             .map_or(fallback, |p| consumed + p.line() as usize);
         match e.into_kind() {
-            csv::ErrorKind::Io(source) => io_err(source),
-            other => err(line, "", Problem::Malformed(format!("{other:?}"))),
+            csv::ErrorKind::Io(source) => match line_too_long(&source) {
+                Some(l) => err(l, "", Problem::LineTooLong),
+                None => io_err(source),
+            },
+            csv::ErrorKind::Utf8 { .. } => err(line, "", Problem::NotUtf8),
+            _ => err(line, "", Problem::Malformed("not CSV".into())),
         }
     };
 
@@ -529,6 +603,9 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     {
         let line = line_of(&record, last_line + 1);
         last_line = line;
+        if log.len() == MAX_ROWS {
+            return Err(err(line, Signal::Time.name(), Problem::TooManyRows));
+        }
         if record.len() != names.len() {
             let column = names
                 .get(record.len().min(names.len().saturating_sub(1)))
@@ -548,16 +625,20 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
             let text = record.get(i).unwrap_or("");
             let v = match text.parse::<f64>() {
                 Ok(v) if v.is_finite() => v,
+                _ if text.is_empty() => return Err(err(line, s.name(), Problem::EmptyField)),
                 _ => {
                     return Err(err(
                         line,
                         s.name(),
                         Problem::NotANumber {
-                            text: text.to_string(),
+                            text: excerpt(text),
                         },
                     ))
                 }
             };
+            if out_of_range(s, v) {
+                return Err(err(line, s.name(), beyond(s, v)));
+            }
             if s == Signal::Time {
                 if let Some(&previous) = log.t_s.last() {
                     if v <= previous {
@@ -582,17 +663,48 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     Ok(log)
 }
 
+/// Whether `v` lies outside the physical range of `signal`'s column.
+fn out_of_range(signal: Signal, v: f64) -> bool {
+    let (low, high, _) = physical_range(signal);
+    !(low..=high).contains(&v)
+}
+
+/// The problem of a value outside its column's physical range.
+fn beyond(signal: Signal, value: f64) -> Problem {
+    let (low, high, unit) = physical_range(signal);
+    Problem::OutOfRange {
+        value,
+        low,
+        high,
+        unit,
+    }
+}
+
 /// Writes `log` to `path` atomically, after [`BenchLog::check`]: metadata lines, the header
 /// of the columns present, one row per sample in shortest round-trip notation.
 pub fn write(path: &Path, log: &BenchLog) -> Result<(), BenchLogError> {
     log.check(path)?;
-    crate::atomic_file::write_with(path, |w| write_to(w, log)).map_err(|source| {
+    crate::output::atomic::write_with(path, |w| write_to(w, log)).map_err(|source| {
         BenchLogError::Write {
             file: path.to_path_buf(),
             source,
         }
     })
 }
+
+/// `log` as the bytes [`write`] puts in a file, after the same checks.
+pub fn to_bytes(log: &BenchLog) -> Result<Vec<u8>, BenchLogError> {
+    log.check(Path::new(IN_MEMORY))?;
+    let mut out = Vec::new();
+    write_to(&mut out, log).map_err(|source| BenchLogError::Write {
+        file: PathBuf::from(IN_MEMORY),
+        source,
+    })?;
+    Ok(out)
+}
+
+/// What errors about a log held in memory name as its file.
+const IN_MEMORY: &str = "<in memory>";
 
 /// Writes `log` (assumed checked) to `w`.
 fn write_to(w: &mut dyn Write, log: &BenchLog) -> io::Result<()> {
@@ -628,254 +740,4 @@ pub fn format_value(out: &mut String, v: f64) {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn log_text(rows: usize, header: &str, row: impl Fn(usize) -> String) -> String {
-        let mut s = String::from("# source: test\n# rig: nominal\n");
-        s.push_str(header);
-        s.push('\n');
-        for i in 0..rows {
-            s.push_str(&row(i));
-            s.push('\n');
-        }
-        s
-    }
-
-    const HEADER: &str = "t_s,p_ref_pa,p_pa,speed_rad_s,iq_a,id_a";
-
-    fn good_row(i: usize) -> String {
-        format!("{},5e6,{},6.0,1.5,0", i as f64 * 1e-3, 5e6 + i as f64)
-    }
-
-    fn parse_str(s: &str) -> Result<BenchLog, BenchLogError> {
-        parse(s.as_bytes(), Path::new("test.csv"))
-    }
-
-    fn content_error(s: &str) -> (usize, String, Problem) {
-        match parse_str(s).unwrap_err() {
-            BenchLogError::Content {
-                line,
-                column,
-                problem,
-                ..
-            } => (line, column, problem),
-            e => panic!("expected a content error, got {e}"),
-        }
-    }
-
-    #[test]
-    fn reads_metadata_and_columns_by_name() {
-        let text = log_text(
-            100,
-            "id_a,iq_a, speed_rad_s ,p_pa,p_ref_pa,t_s,mode,x_m",
-            |i| format!("0,{},6,{},5e6,{},hold,1.5E-3", i, 1e6 + i as f64, i),
-        );
-        let log = parse_str(&text).unwrap();
-        assert_eq!(log.len(), 100);
-        assert_eq!(log.meta("source"), Some("test"));
-        assert_eq!(log.meta("rig"), Some("nominal"));
-        assert_eq!(log.t_s[99], 99.0);
-        assert_eq!(log.p_pa[3], 1e6 + 3.0);
-        assert_eq!(log.iq_a[7], 7.0);
-        assert_eq!(log.speed_rad_s[0], 6.0);
-        assert_eq!(log.x_m.as_ref().unwrap()[0], 1.5e-3);
-        assert!(log.theta_m_rad.is_none());
-    }
-
-    #[test]
-    fn each_contract_violation_names_line_and_column() {
-        // Lines: 1–2 metadata, 3 header, data from line 4.
-        let (l, c, p) = content_error(&log_text(100, "t_s,p_ref_pa,p_pa,iq_a,id_a", |i| {
-            format!("{i},0,0,0,0")
-        }));
-        assert_eq!(
-            (l, c.as_str(), p),
-            (3, "speed_rad_s", Problem::MissingColumn)
-        );
-
-        let (l, c, p) = content_error(&log_text(100, &format!("{HEADER},p_pa"), |i| {
-            format!("{},0", good_row(i))
-        }));
-        assert_eq!(
-            (l, c.as_str(), p),
-            (
-                3,
-                "p_pa",
-                Problem::DuplicateColumn {
-                    first: 3,
-                    second: 7
-                }
-            )
-        );
-
-        let (l, c, p) = content_error(&log_text(100, HEADER, |i| {
-            if i == 10 {
-                "0.01,5e6,abc,6,1.5,0".into()
-            } else {
-                good_row(i)
-            }
-        }));
-        assert_eq!(
-            (l, c.as_str(), p),
-            (14, "p_pa", Problem::NotANumber { text: "abc".into() })
-        );
-
-        let (l, c, _) = content_error(&log_text(100, HEADER, |i| {
-            if i == 50 {
-                "0.05,5e6,1,NaN,1.5,0".into()
-            } else {
-                good_row(i)
-            }
-        }));
-        assert_eq!((l, c.as_str()), (54, "speed_rad_s"));
-
-        let (l, c, p) = content_error(&log_text(100, HEADER, |i| {
-            if i == 20 {
-                "0.019,5e6,1,6,1.5,0".into()
-            } else {
-                good_row(i)
-            }
-        }));
-        assert_eq!(
-            (l, c.as_str(), p),
-            (
-                24,
-                "t_s",
-                Problem::TimeNotIncreasing {
-                    previous: 0.019,
-                    value: 0.019
-                }
-            )
-        );
-
-        let (l, c, p) = content_error(&log_text(99, HEADER, good_row));
-        assert_eq!(
-            (l, c.as_str(), p),
-            (102, "t_s", Problem::TooFewRows { rows: 99 })
-        );
-
-        let (l, c, p) = content_error(&log_text(100, HEADER, |i| {
-            if i == 30 {
-                "0.03,5e6,1,6,1.5".into()
-            } else {
-                good_row(i)
-            }
-        }));
-        assert_eq!(
-            (l, c.as_str(), p),
-            (
-                34,
-                "id_a",
-                Problem::WrongFieldCount {
-                    expected: 6,
-                    found: 5
-                }
-            )
-        );
-        let (l, c, _) = content_error(&log_text(100, HEADER, |i| {
-            if i == 31 {
-                format!("{},9", good_row(i))
-            } else {
-                good_row(i)
-            }
-        }));
-        assert_eq!((l, c.as_str()), (35, "field 7"));
-
-        let (l, _, p) = content_error("# only: metadata\n");
-        assert_eq!((l, p), (2, Problem::NoHeader));
-    }
-
-    #[test]
-    fn message_names_file_line_and_column() {
-        let text = log_text(100, HEADER, |i| {
-            if i == 0 {
-                "0,5e6,inf,6,1.5,0".into()
-            } else {
-                good_row(i)
-            }
-        });
-        let msg = parse(text.as_bytes(), Path::new("runs/a.csv"))
-            .unwrap_err()
-            .to_string();
-        assert!(msg.contains("runs/a.csv"), "{msg}");
-        assert!(msg.contains("line 4"), "{msg}");
-        assert!(msg.contains("column `p_pa`"), "{msg}");
-    }
-
-    #[test]
-    fn write_then_read_is_identity_including_awkward_values() {
-        let mut log = BenchLog {
-            metadata: vec![("source".into(), "sim".into()), ("x".into(), "".into())],
-            ..BenchLog::default()
-        };
-        for i in 0..150 {
-            let t = i as f64 * 1e-4 + 0.1; // not exactly representable sums
-            log.t_s.push(t);
-            log.p_ref_pa.push(5e6);
-            log.p_pa
-                .push(5e6 + (i as f64 * 0.7).sin() * 1.234_567_890_123e4);
-            log.speed_rad_s.push(1.0 / 3.0 + i as f64);
-            log.iq_a.push(-1e-300 * i as f64);
-            log.id_a.push(if i % 2 == 0 { 0.0 } else { -0.0 });
-            log.column_mut(Signal::OilTemp)
-                .push(f64::MAX / (i + 1) as f64);
-        }
-        let dir = std::env::temp_dir().join(format!("eha-bench-log-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("rt.csv");
-        write(&path, &log).unwrap();
-        let back = read(&path).unwrap();
-        assert_eq!(back.len(), log.len());
-        for (s, c) in log.columns() {
-            let b = back.column(s).unwrap();
-            assert!(
-                c.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
-                "{} differs",
-                s.name()
-            );
-        }
-        assert_eq!(back.metadata, log.metadata);
-        assert!(back.x_m.is_none());
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn write_refuses_a_log_the_reader_would_reject_and_leaves_no_file() {
-        let dir = std::env::temp_dir().join(format!("eha-bench-log-bad-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("bad.csv");
-        let mut log = parse_str(&log_text(100, HEADER, good_row)).unwrap();
-        log.p_pa[5] = f64::NAN;
-        assert!(matches!(
-            write(&path, &log),
-            Err(BenchLogError::Content { line: 9, .. })
-        ));
-        log.p_pa[5] = 0.0;
-        log.speed_rad_s.pop();
-        assert!(matches!(
-            write(&path, &log),
-            Err(BenchLogError::Content {
-                problem: Problem::ColumnLength { .. },
-                ..
-            })
-        ));
-        assert!(!path.exists());
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn format_is_shortest_round_trip() {
-        let f = |v: f64| {
-            let mut s = String::new();
-            format_value(&mut s, v);
-            s
-        };
-        assert_eq!(f(5e6), "5000000");
-        assert_eq!(f(0.1), "0.1");
-        assert_eq!(f(1e-13), "1e-13");
-        assert_eq!(f(-2.5e20), "-2.5e20");
-        assert_eq!(f(0.0), "0");
-    }
-}
+mod tests;

@@ -1,7 +1,10 @@
 //! Writing output files atomically: the bytes go to a fresh temporary file in the target's
 //! directory, which is flushed to disk and then renamed over the target. A reader (or a
 //! user after a crash or an error) sees the old file or the complete new one, never a
-//! half-written one; on any error the temporary file is removed.
+//! half-written one; on any error or interruption the temporary file is removed.
+//!
+//! A symbolic link is followed: the file it names is replaced and the link stays. Anything
+//! but a regular file (a FIFO, a device node, a socket, a folder) is never replaced.
 
 use std::fs::{self, OpenOptions};
 use std::io::{self, Write};
@@ -23,14 +26,16 @@ pub fn write_with<F>(path: &Path, fill: F) -> io::Result<()>
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
-    let tmp = temporary_path(path)?;
+    let target = super::paths::replaced_file(path)?.unwrap_or_else(|| path.to_path_buf());
+    let tmp = temporary_path(&target)?;
+    let _cleanup = super::interrupt::remove_on_interrupt(&tmp);
     let result = (|| {
         let file = OpenOptions::new().write(true).create_new(true).open(&tmp)?;
         let mut w = io::BufWriter::new(file);
         fill(&mut w)?;
         let file = w.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
-        fs::rename(&tmp, path)
+        fs::rename(&tmp, &target)
     })();
     if result.is_err() {
         // Best effort: the error that matters is the one being returned.
@@ -60,10 +65,7 @@ mod tests {
     use super::*;
 
     fn scratch_dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("eha-atomic-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
+        crate::output::scratch_dir(&format!("atomic-{name}"))
     }
 
     #[test]

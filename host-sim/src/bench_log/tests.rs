@@ -1,0 +1,251 @@
+//! The bench-log reader and writer against the contract's rules.
+
+use super::*;
+
+fn log_text(rows: usize, header: &str, row: impl Fn(usize) -> String) -> String {
+    let mut s = String::from("# source: test\n# rig: nominal\n");
+    s.push_str(header);
+    s.push('\n');
+    for i in 0..rows {
+        s.push_str(&row(i));
+        s.push('\n');
+    }
+    s
+}
+
+const HEADER: &str = "t_s,p_ref_pa,p_pa,speed_rad_s,iq_a,id_a";
+
+fn good_row(i: usize) -> String {
+    format!("{},5e6,{},6.0,1.5,0", i as f64 * 1e-3, 5e6 + i as f64)
+}
+
+fn parse_str(s: &str) -> Result<BenchLog, BenchLogError> {
+    parse(s.as_bytes(), Path::new("test.csv"))
+}
+
+fn content_error(s: &str) -> (usize, String, Problem) {
+    match parse_str(s).unwrap_err() {
+        BenchLogError::Content {
+            line,
+            column,
+            problem,
+            ..
+        } => (line, column, problem),
+        e => panic!("expected a content error, got {e}"),
+    }
+}
+
+#[test]
+fn reads_metadata_and_columns_by_name() {
+    let text = log_text(
+        100,
+        "id_a,iq_a, speed_rad_s ,p_pa,p_ref_pa,t_s,mode,x_m",
+        |i| format!("0,{},6,{},5e6,{},hold,1.5E-3", i, 1e6 + i as f64, i),
+    );
+    let log = parse_str(&text).unwrap();
+    assert_eq!(log.len(), 100);
+    assert_eq!(log.meta("source"), Some("test"));
+    assert_eq!(log.meta("rig"), Some("nominal"));
+    assert_eq!(log.t_s[99], 99.0);
+    assert_eq!(log.p_pa[3], 1e6 + 3.0);
+    assert_eq!(log.iq_a[7], 7.0);
+    assert_eq!(log.speed_rad_s[0], 6.0);
+    assert_eq!(log.x_m.as_ref().unwrap()[0], 1.5e-3);
+    assert!(log.theta_m_rad.is_none());
+}
+
+#[test]
+fn each_contract_violation_names_line_and_column() {
+    // Lines: 1–2 metadata, 3 header, data from line 4.
+    let (l, c, p) = content_error(&log_text(100, "t_s,p_ref_pa,p_pa,iq_a,id_a", |i| {
+        format!("{i},0,0,0,0")
+    }));
+    assert_eq!(
+        (l, c.as_str(), p),
+        (3, "speed_rad_s", Problem::MissingColumn)
+    );
+
+    let (l, c, p) = content_error(&log_text(100, &format!("{HEADER},p_pa"), |i| {
+        format!("{},0", good_row(i))
+    }));
+    assert_eq!(
+        (l, c.as_str(), p),
+        (
+            3,
+            "p_pa",
+            Problem::DuplicateColumn {
+                first: 3,
+                second: 7
+            }
+        )
+    );
+
+    let (l, c, p) = content_error(&log_text(100, HEADER, |i| {
+        if i == 10 {
+            "0.01,5e6,abc,6,1.5,0".into()
+        } else {
+            good_row(i)
+        }
+    }));
+    assert_eq!(
+        (l, c.as_str(), p),
+        (14, "p_pa", Problem::NotANumber { text: "abc".into() })
+    );
+
+    let (l, c, _) = content_error(&log_text(100, HEADER, |i| {
+        if i == 50 {
+            "0.05,5e6,1,NaN,1.5,0".into()
+        } else {
+            good_row(i)
+        }
+    }));
+    assert_eq!((l, c.as_str()), (54, "speed_rad_s"));
+
+    let (l, c, p) = content_error(&log_text(100, HEADER, |i| {
+        if i == 20 {
+            "0.019,5e6,1,6,1.5,0".into()
+        } else {
+            good_row(i)
+        }
+    }));
+    assert_eq!(
+        (l, c.as_str(), p),
+        (
+            24,
+            "t_s",
+            Problem::TimeNotIncreasing {
+                previous: 0.019,
+                value: 0.019
+            }
+        )
+    );
+
+    let (l, c, p) = content_error(&log_text(99, HEADER, good_row));
+    assert_eq!(
+        (l, c.as_str(), p),
+        (102, "t_s", Problem::TooFewRows { rows: 99 })
+    );
+
+    let (l, c, p) = content_error(&log_text(100, HEADER, |i| {
+        if i == 30 {
+            "0.03,5e6,1,6,1.5".into()
+        } else {
+            good_row(i)
+        }
+    }));
+    assert_eq!(
+        (l, c.as_str(), p),
+        (
+            34,
+            "id_a",
+            Problem::WrongFieldCount {
+                expected: 6,
+                found: 5
+            }
+        )
+    );
+    let (l, c, _) = content_error(&log_text(100, HEADER, |i| {
+        if i == 31 {
+            format!("{},9", good_row(i))
+        } else {
+            good_row(i)
+        }
+    }));
+    assert_eq!((l, c.as_str()), (35, "field 7"));
+
+    let (l, _, p) = content_error("# only: metadata\n");
+    assert_eq!((l, p), (2, Problem::NoHeader));
+}
+
+#[test]
+fn message_names_file_line_and_column() {
+    let text = log_text(100, HEADER, |i| {
+        if i == 0 {
+            "0,5e6,inf,6,1.5,0".into()
+        } else {
+            good_row(i)
+        }
+    });
+    let msg = parse(text.as_bytes(), Path::new("runs/a.csv"))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("runs/a.csv"), "{msg}");
+    assert!(msg.contains("line 4"), "{msg}");
+    assert!(msg.contains("column `p_pa`"), "{msg}");
+}
+
+#[test]
+fn write_then_read_is_identity_including_awkward_values() {
+    let mut log = BenchLog {
+        metadata: vec![("source".into(), "sim".into()), ("x".into(), "".into())],
+        ..BenchLog::default()
+    };
+    for i in 0..150 {
+        let t = i as f64 * 1e-4 + 0.1; // not exactly representable sums
+        log.t_s.push(t);
+        log.p_ref_pa.push(5e6);
+        log.p_pa
+            .push(5e6 + (i as f64 * 0.7).sin() * 1.234_567_890_123e4);
+        log.speed_rad_s.push(1.0 / 3.0 + i as f64);
+        log.iq_a.push(-1e-300 * i as f64);
+        log.id_a.push(if i % 2 == 0 { 0.0 } else { -0.0 });
+        // Largest in its physical range, and awkward quotients of it.
+        log.column_mut(Signal::OilTemp).push(1e4 / (i + 1) as f64);
+    }
+    let dir = std::env::temp_dir().join(format!("eha-bench-log-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("rt.csv");
+    write(&path, &log).unwrap();
+    let back = read(&path).unwrap();
+    assert_eq!(back.len(), log.len());
+    for (s, c) in log.columns() {
+        let b = back.column(s).unwrap();
+        assert!(
+            c.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{} differs",
+            s.name()
+        );
+    }
+    assert_eq!(back.metadata, log.metadata);
+    assert!(back.x_m.is_none());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn write_refuses_a_log_the_reader_would_reject_and_leaves_no_file() {
+    let dir = std::env::temp_dir().join(format!("eha-bench-log-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.csv");
+    let mut log = parse_str(&log_text(100, HEADER, good_row)).unwrap();
+    log.p_pa[5] = f64::NAN;
+    assert!(matches!(
+        write(&path, &log),
+        Err(BenchLogError::Content { line: 9, .. })
+    ));
+    log.p_pa[5] = 0.0;
+    log.speed_rad_s.pop();
+    assert!(matches!(
+        write(&path, &log),
+        Err(BenchLogError::Content {
+            problem: Problem::ColumnLength { .. },
+            ..
+        })
+    ));
+    assert!(!path.exists());
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn format_is_shortest_round_trip() {
+    let f = |v: f64| {
+        let mut s = String::new();
+        format_value(&mut s, v);
+        s
+    };
+    assert_eq!(f(5e6), "5000000");
+    assert_eq!(f(0.1), "0.1");
+    assert_eq!(f(1e-13), "1e-13");
+    assert_eq!(f(-2.5e20), "-2.5e20");
+    assert_eq!(f(0.0), "0");
+}

@@ -1,0 +1,17 @@
+//! Progress on standard error for runs that take long (indicatif): drawn only on a
+//! terminal, so pipes and logs stay clean.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use std::time::Duration;
+
+/// A spinner with `message` and the elapsed time, ticking until finished.
+pub fn spinner(message: String) -> ProgressBar {
+    let b = ProgressBar::new_spinner();
+    b.set_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    b.set_message(message);
+    b.enable_steady_tick(Duration::from_millis(200));
+    b
+}

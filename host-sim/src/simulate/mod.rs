@@ -1,0 +1,332 @@
+//! The closed-loop runs: `eha simulate` (a named scenario to a bench log) here, `eha demo`
+//! in [`demo`], and the low-speed holding run both the demo and the precharge sweep
+//! (`crate::study::precharge_sweep`) measure, in [`holding`].
+
+pub mod demo;
+pub mod holding;
+
+use crate::bench_log::limits::MAX_ROWS;
+use crate::bench_log::{self, BenchLog, MIN_ROWS};
+use crate::output::paths::Declared;
+use crate::output::{print_stdout, write_json, CliError};
+use crate::rig_file;
+use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
+use crate::values::{positive_f64, show};
+use clap::Args;
+use closed_loop::{by_name, SCENARIOS};
+use plant_model::effects::EFFECT_NAMES;
+use plant_model::{Effect, Rig};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Log rate of the simulated bench logs. [Hz]
+pub const LOG_RATE_HZ: f64 = 2000.0;
+
+/// `eha simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Scenario name (`--list` names them).
+    #[arg(long, value_name = "NAME", required_unless_present = "list")]
+    pub scenario: Option<String>,
+    /// Bench log to write.
+    #[arg(long, value_name = "LOG.csv", required_unless_present = "list")]
+    pub out: Option<PathBuf>,
+    /// Absorber precharge (gauge), replacing the rig's. [Pa]
+    #[arg(long, value_name = "PA", value_parser = positive_f64, allow_negative_numbers = true)]
+    pub precharge: Option<f64>,
+    /// Rig file of the simulated actuator when it is not the one the controller is
+    /// configured from (`--rig`, `--precharge`): a bench whose absorber or shaft differs
+    /// from what the engineer believes, as `eha tune` corrects.
+    #[arg(long, value_name = "FILE")]
+    pub plant_rig: Option<PathBuf>,
+    /// Simulated duration, replacing the scenario's. [s]
+    #[arg(long, value_name = "S", value_parser = positive_f64, allow_negative_numbers = true)]
+    pub duration: Option<f64>,
+    /// Effects to switch on: names from effects.md, each optionally with parameters,
+    /// e.g. `piston_ripple,cogging_torque:amplitude_nm=0.05,order=72`.
+    #[arg(long, value_name = "LIST", value_parser = parse_effect_list)]
+    pub effects: Option<EffectList>,
+    /// Seed of the sensor noise.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+    /// Log rate (a divisor of the 20 kHz PWM rate is logged exactly; typical bench logs
+    /// are 1 kHz). [Hz]
+    #[arg(long, value_name = "HZ", default_value = "2000", value_parser = log_rate, allow_negative_numbers = true)]
+    pub log_rate: f64,
+    /// Name the scenarios and exit.
+    #[arg(long)]
+    pub list: bool,
+    /// Write a run summary as JSON, with the real-time factor (`-`: standard output).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+/// A log rate: positive and at most the 20 kHz PWM rate the telemetry is sampled at. [Hz]
+fn log_rate(s: &str) -> Result<f64, String> {
+    let v = positive_f64(s)?;
+    if v > 20_000.0 {
+        return Err(format!("{v} Hz is above the 20000 Hz telemetry rate"));
+    }
+    Ok(v)
+}
+
+impl SimulateArgs {
+    /// The files it reads and writes.
+    pub fn paths(&self) -> Declared<'_> {
+        Declared::default()
+            .input("--plant-rig", self.plant_rig.as_ref())
+            .file("--out", self.out.as_ref())
+            .file("--json", self.json.as_ref())
+    }
+}
+
+/// The parsed `--effects` list.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EffectList(pub Vec<Effect>);
+
+/// Parses `name[:param=value,param=value…][,name…]`: a comma-separated token holding `=`
+/// but no `:` continues the previous effect's parameters, any other token starts an
+/// effect (effect names never contain `=`).
+pub fn parse_effect_list(list: &str) -> Result<EffectList, String> {
+    let mut specs: Vec<String> = Vec::new();
+    for token in list.split(',').map(str::trim).filter(|t| !t.is_empty()) {
+        match specs.last_mut() {
+            Some(spec) if token.contains('=') && !token.contains(':') => {
+                spec.push(',');
+                spec.push_str(token);
+            }
+            _ => specs.push(token.to_string()),
+        }
+    }
+    if specs.is_empty() {
+        return Err("no effect named".into());
+    }
+    specs
+        .iter()
+        .map(|spec| {
+            Effect::parse(spec).map_err(|e| {
+                format!(
+                    "effect `{spec}`: {e} (effects: {})",
+                    EFFECT_NAMES.join(", ")
+                )
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(EffectList)
+}
+
+pub(crate) fn rig_name(rig: &Rig) -> &'static str {
+    if *rig == Rig::nominal() {
+        "nominal"
+    } else {
+        "file"
+    }
+}
+
+pub(crate) fn effects_text(effects: &[Effect]) -> String {
+    if effects.is_empty() {
+        return "none".into();
+    }
+    effects
+        .iter()
+        .map(|e| {
+            let params: Vec<String> = e
+                .parameters()
+                .iter()
+                .flatten()
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect();
+            if params.is_empty() {
+                e.name().to_string()
+            } else {
+                format!("{}:{}", e.name(), params.join(","))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(";")
+}
+
+/// The plant rig: `rig` with `effects` switched on, validated.
+pub(crate) fn plant_rig(rig: &Rig, effects: &[Effect]) -> Result<Rig, CliError> {
+    let mut r = rig.clone();
+    for e in effects {
+        e.apply(&mut r);
+    }
+    r.validate()
+        .map_err(|e| CliError::BadInput(format!("with the requested effects, {e}")))?;
+    Ok(r)
+}
+
+/// `run` unless its state left the physical range: a rig the integration cannot follow
+/// (bad input, exit status 2) rather than a log of NaN.
+pub(crate) fn converged(run: Run) -> Result<Run, CliError> {
+    match first_unphysical(&run.log) {
+        None => Ok(run),
+        Some((t, name, v)) => Err(CliError::BadInput(format!(
+            "the simulation diverged: `{name}` reached {v:e} at t = {t:.6} s; the rig's \
+             parameters make the model numerically unstable (check the rig file's values)"
+        ))),
+    }
+}
+
+/// Checks before a run that `duration_s` [s] at `log_rate_hz` [Hz] gives a bench log of
+/// [`MIN_ROWS`] to [`MAX_ROWS`] rows (`period_s`: the PWM period [s]).
+fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<(), CliError> {
+    let (every, rows) = log_plan(duration_s, log_rate_hz, period_s);
+    let rate = 1.0 / (period_s * every as f64);
+    let asked = format!(
+        "--duration {} s at --log-rate {} Hz",
+        show(duration_s),
+        show(log_rate_hz)
+    );
+    if rows > MAX_ROWS as f64 {
+        return Err(CliError::BadInput(format!(
+            "{asked} would log {} rows; a bench log holds at most {MAX_ROWS} ({:.0} s at this \
+             rate)",
+            show(rows),
+            MAX_ROWS as f64 / rate
+        )));
+    }
+    if rows < MIN_ROWS as f64 {
+        return Err(CliError::BadInput(format!(
+            "{asked} would log {rows} rows; a bench log needs at least {MIN_ROWS}"
+        )));
+    }
+    Ok(())
+}
+
+pub(crate) fn write_log(path: &Path, log: &BenchLog) -> Result<(), CliError> {
+    bench_log::write(path, log)?;
+    Ok(())
+}
+
+/// `eha simulate`.
+pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
+    if args.list {
+        let mut s = String::new();
+        for sc in &SCENARIOS {
+            let _ = writeln!(
+                s,
+                "{:<15} {:>4.1} s  {}",
+                sc.name, sc.duration_s, sc.description
+            );
+        }
+        return print_stdout(&s);
+    }
+    let name = args.scenario.as_deref().unwrap_or_default();
+    let scenario = by_name(name).ok_or_else(|| {
+        let names: Vec<&str> = SCENARIOS.iter().map(|s| s.name).collect();
+        CliError::BadInput(format!(
+            "unknown scenario `{name}`: the scenarios are {} (see `eha simulate --list`)",
+            names.join(", ")
+        ))
+    })?;
+    let out = args
+        .out
+        .as_ref()
+        .ok_or_else(|| CliError::BadInput("--out LOG.csv is required".into()))?;
+    let mut controller = rig.clone();
+    if let Some(p0) = args.precharge {
+        controller.absorber.precharge_pa = p0;
+    }
+    controller.validate().map_err(|e| {
+        CliError::BadInput(match args.precharge {
+            Some(p0) if e.parameter == "absorber.precharge_pa" => {
+                format!("--precharge {}: {e}", show(p0))
+            }
+            _ => e.to_string(),
+        })
+    })?;
+    let effects = args
+        .effects
+        .as_ref()
+        .map(|e| e.0.clone())
+        .unwrap_or_default();
+    // The plant is the controller's rig unless the bench's actuator is given apart.
+    let plant = match &args.plant_rig {
+        Some(path) => plant_rig(&rig_file::load(path)?, &effects)?,
+        None => plant_rig(&controller, &effects)?,
+    };
+    let duration = args.duration.unwrap_or(scenario.duration_s);
+    let period_s = 1.0 / closed_loop::controller_config(&controller).rates.pwm_hz as f64;
+    check_log_length(duration, args.log_rate, period_s)?;
+    let seed = args.seed.unwrap_or(1);
+    let mut metadata = vec![
+        ("source".into(), "simulation".into()),
+        ("rig".into(), rig_name(rig).into()),
+        ("scenario".into(), scenario.name.into()),
+        ("effects".into(), effects_text(&effects)),
+        (
+            "precharge_pa".into(),
+            format!("{}", controller.absorber.precharge_pa),
+        ),
+        ("seed".into(), format!("{seed}")),
+    ];
+    if let Some(path) = &args.plant_rig {
+        metadata.push(("plant_rig".into(), path.display().to_string()));
+    }
+    let r = run(
+        &plant,
+        &controller,
+        scenario,
+        &RunOptions {
+            duration_s: duration,
+            log_rate_hz: args.log_rate,
+            seed,
+            progress: true,
+            metadata,
+        },
+    )
+    .map_err(CliError::Failed)
+    .and_then(converged)?;
+    write_log(out, &r.log)?;
+    eprintln!(
+        "{}: {} rows over {duration} s written to {} ({:.0}× real time)",
+        scenario.name,
+        r.log.len(),
+        out.display(),
+        r.real_time_factor
+    );
+    if let Some(json_path) = &args.json {
+        write_json(
+            json_path,
+            &json!({
+                "scenario": scenario.name,
+                "duration_s": duration,
+                "rows": r.log.len(),
+                "out": out.display().to_string(),
+                "real_time_factor": r.real_time_factor,
+            }),
+        )?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn effect_lists_group_parameters_with_their_effect() {
+        let l =
+            parse_effect_list("piston_ripple,cogging_torque:amplitude_nm=0.05,order=72,dead_time")
+                .unwrap();
+        assert_eq!(l.0.len(), 3);
+        assert_eq!(l.0[0].name(), "piston_ripple");
+        assert_eq!(
+            l.0[1],
+            Effect::CoggingTorque {
+                amplitude_nm: 0.05,
+                order: 72,
+                phase_rad: 0.0
+            }
+        );
+        assert_eq!(l.0[2].name(), "dead_time");
+        let e = parse_effect_list("cogging_torque:amplitude=1").unwrap_err();
+        assert!(e.contains("cogging_torque:amplitude=1"), "{e}");
+        assert!(parse_effect_list("warp_drive")
+            .unwrap_err()
+            .contains("warp_drive"));
+    }
+}
