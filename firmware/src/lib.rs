@@ -12,6 +12,7 @@
 //! [`pressure_loop::PressureLoop::step`]) are public for instruction-count benchmarks.
 #![cfg_attr(not(test), no_std)]
 
+pub mod angle_grid;
 pub mod can_protocol;
 pub mod can_server;
 pub mod commissioning;

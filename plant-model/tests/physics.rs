@@ -658,6 +658,12 @@ fn dead_time_costs_one_dead_interval_per_pwm_period() {
     let average = Inverter::new(&p).pole_voltages(&[duty; 3], &[10.0, -5.0, -5.0])[0];
     let loss_average = duty * u_dc - average;
     let textbook = t_d / t_pwm * u_dc;
-    assert!((loss_switching - textbook).abs() < 0.01 * textbook, "{loss_switching} vs {textbook}");
-    assert!((loss_average - textbook).abs() < 1e-9 * textbook, "{loss_average} vs {textbook}");
+    assert!(
+        (loss_switching - textbook).abs() < 0.01 * textbook,
+        "{loss_switching} vs {textbook}"
+    );
+    assert!(
+        (loss_average - textbook).abs() < 1e-9 * textbook,
+        "{loss_average} vs {textbook}"
+    );
 }

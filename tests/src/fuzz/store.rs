@@ -111,7 +111,8 @@ pub fn param_store(data: &[u8]) {
             seal(page);
         }
     }
-    let mut store = ParamStore::new(RamFlash(mem), 0, PAGE as u32, PAGE as u32).expect("the layout fits");
+    let mut store =
+        ParamStore::new(RamFlash(mem), 0, PAGE as u32, PAGE as u32).expect("the layout fits");
     let defaults = Config::nominal();
     let (config, outcome) = boot_config(&mut store, &defaults);
     assert!(
