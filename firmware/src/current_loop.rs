@@ -208,7 +208,11 @@ impl CurrentLoop {
         u_dq: Dq,
     ) -> CurrentLoopState {
         state.u_dq = u_dq;
-        let m = modulate_finite(inverse_park(u_dq, sc), state.u_dc, self.window.max_duty());
+        let m = modulate_finite(
+            inverse_park(u_dq, sc),
+            state.u_dc,
+            self.window.duty_window(),
+        );
         state.duties = m.duties;
         self.window.record(m.above_window);
         state

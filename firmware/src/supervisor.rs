@@ -105,11 +105,15 @@ pub enum FaultCode {
     /// DBANK cleared): nothing was loaded, the defaults are in use and saves are refused.
     /// (18)
     ParameterFlashLayout = 18,
+    /// The stored torque feed-forward table was refused (wrong size, format version or
+    /// CRC, or an amplitude above `compensation.max_current_a`): the drive runs
+    /// uncompensated. (19)
+    CompensationTableInvalid = 19,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 18] = [
+    pub const ALL: [FaultCode; 19] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -128,10 +132,11 @@ impl FaultCode {
         FaultCode::ParameterStoreInvalid,
         FaultCode::HardwareBreak,
         FaultCode::ParameterFlashLayout,
+        FaultCode::CompensationTableInvalid,
     ];
 
     /// Largest telemetry code.
-    pub const MAX_CODE: u8 = FaultCode::ParameterFlashLayout as u8;
+    pub const MAX_CODE: u8 = FaultCode::CompensationTableInvalid as u8;
 
     /// Telemetry code (1..=[`FaultCode::MAX_CODE`]).
     pub fn code(self) -> u8 {
@@ -163,6 +168,7 @@ impl FaultCode {
                 | FaultCode::ParameterStoreInvalid
                 | FaultCode::HardwareBreak
                 | FaultCode::ParameterFlashLayout
+                | FaultCode::CompensationTableInvalid
         )
     }
 }
@@ -193,6 +199,9 @@ impl fmt::Display for FaultCode {
             }
             FaultCode::ParameterFlashLayout => {
                 "flash not dual-bank (DBANK option bit): parameter store unavailable"
+            }
+            FaultCode::CompensationTableInvalid => {
+                "stored torque feed-forward table refused, running uncompensated"
             }
         };
         write!(f, "fault {}: {}", self.code(), s)

@@ -63,22 +63,46 @@ pub fn modulate_sampled(v: AlphaBeta, u_dc: f32, max_sampled_duty: f32) -> Modul
     if !(v.alpha.is_finite() && v.beta.is_finite()) {
         return Modulation::ZERO;
     }
-    modulate_finite(v, u_dc, max_sampled_duty)
+    modulate_finite(v, u_dc, DutyWindow::new(max_sampled_duty))
+}
+
+/// The sampling window as the modulator's common path uses it: the largest readable duty
+/// w and the largest span (as a fraction of U_dc) that keeps every duty within it and
+/// inside [`SPAN_LIMIT`], `min(2w − 1, SPAN_LIMIT)`, computed once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DutyWindow {
+    /// Largest readable duty w. [1]
+    pub max_duty: f32,
+    /// Largest span of the common path. [1]
+    pub common_span: f32,
+}
+
+impl DutyWindow {
+    /// For the largest readable duty `max_duty` [1].
+    pub fn new(max_duty: f32) -> DutyWindow {
+        let top = 2.0 * max_duty - 1.0;
+        DutyWindow {
+            max_duty,
+            common_span: if top < SPAN_LIMIT { top } else { SPAN_LIMIT },
+        }
+    }
 }
 
 /// [`modulate_sampled`] for a command known to be finite (the current loop's: its PIs'
 /// outputs are saturated finite values, its sine table finite for any angle). A DC link
 /// below 1 V (or NaN) gives 50 % on all phases. Always inlined (the current loop's hot
-/// path), its rare branch never.
+/// path); a command beyond the hexagon or the window takes a cold branch.
 ///
-/// No clamp on the common path: with the span limited to [`SPAN_LIMIT`]·U_dc each phase's
+/// No clamp on the common path: with the span at most [`SPAN_LIMIT`]·U_dc each phase's
 /// distance from the centring offset is at most half the span (the three phase voltages
 /// sum to zero, so the highest is ≥ 0 ≥ the lowest and every rounding error is relative
-/// to the span), so `(x + offset)·k` is below ½ by far more than the few ulps the f32
-/// arithmetic can add, and `½ + (x + offset)·k` rounds into [0, 1].
+/// to the span), so `(x + offset)/U_dc` is below ½ by far more than the few ulps the f32
+/// arithmetic can add, and `½ + (x + offset)/U_dc` rounds into [0, 1].
 #[inline(always)]
-pub fn modulate_finite(v: AlphaBeta, u_dc: f32, max_sampled_duty: f32) -> Modulation {
-    if u_dc.is_nan() || u_dc < 1.0 {
+pub fn modulate_finite(v: AlphaBeta, u_dc: f32, window: DutyWindow) -> Modulation {
+    // One comparison that also refuses NaN.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(u_dc >= 1.0) {
         return Modulation::ZERO;
     }
     let [a, b, c] = inverse_clarke(v);
@@ -87,33 +111,24 @@ pub fn modulate_finite(v: AlphaBeta, u_dc: f32, max_sampled_duty: f32) -> Modula
     let max = if c > hi_ab { c } else { hi_ab };
     let min = if c < lo_ab { c } else { lo_ab };
     let span = max - min;
-    let linear = 1.0 / u_dc;
-    let (k, limited) = if span * linear > SPAN_LIMIT {
-        (SPAN_LIMIT / span, true)
-    } else {
-        (linear, false)
-    };
+    let k = 1.0 / u_dc;
     let zero = -0.5 * (max + min);
     // The highest duty is 1/2 + span·k/2: at or below the window (the usual case) the
     // middle one is too, and nothing moves.
-    if span * k > 2.0 * max_sampled_duty - 1.0 {
+    if span * k > window.common_span {
         let p = Phases {
             v: [a, b, c],
             max,
             min,
             zero,
         };
-        return keep_middle_readable(v, p, u_dc, k, max_sampled_duty, limited);
+        return beyond_common(v, p, u_dc, window.max_duty);
     }
     let duty = |x: f32| 0.5 + (x + zero) * k;
-    let scale = k * u_dc;
     Modulation {
         duties: [duty(a), duty(b), duty(c)],
-        limited,
-        applied: AlphaBeta {
-            alpha: v.alpha * scale,
-            beta: v.beta * scale,
-        },
+        limited: false,
+        applied: v,
         above_window: None,
     }
 }
@@ -143,20 +158,21 @@ struct Phases {
     zero: f32,
 }
 
-/// The highest duty is above the window `w`: the modulation of `cmd` (phases `p`, from the
-/// DC link `u_dc`, volts-to-duty factor so far `k` [1/V], `limited` whether the command was
-/// already scaled) with the middle duty at most `w` (see the module documentation). The
-/// duties are clamped to [0, 1] against rounding here, off the common path.
+/// The command is beyond the hexagon (its span above [`SPAN_LIMIT`]·U_dc) or its highest
+/// duty above the window `w`: the command limited to the hexagon keeping its angle, then
+/// the modulation of `cmd` (phases `p`, from the DC link `u_dc`) with the middle duty at
+/// most `w` (see the module documentation). The duties are clamped to [0, 1] against
+/// rounding here, off the common path.
 #[cold]
 #[inline(never)]
-fn keep_middle_readable(
-    cmd: AlphaBeta,
-    p: Phases,
-    u_dc: f32,
-    k: f32,
-    w: f32,
-    limited: bool,
-) -> Modulation {
+fn beyond_common(cmd: AlphaBeta, p: Phases, u_dc: f32, w: f32) -> Modulation {
+    let span = p.max - p.min;
+    let linear = 1.0 / u_dc;
+    let (k, limited) = if span * linear > SPAN_LIMIT {
+        (SPAN_LIMIT / span, true)
+    } else {
+        (linear, false)
+    };
     let Phases { v, max, min, zero } = p;
     // The phase voltages sum to zero.
     let mid = -(max + min);
