@@ -33,10 +33,11 @@
 //! # Bounds
 //!
 //! The table's amplitude over the operating range, `g·(max|c₀| + max|c_p|·p_trip +
-//! max|c_i|·I_trip)` with the over-pressure and over-current trip levels, must stay at or
-//! below `compensation.max_current_a`: a committed table, a scale or a limit that would
-//! break it is refused naming the bound ([`Compensation::check_amplitude`]), so the step
-//! needs no clamp of its own.
+//! max|c_i|·I_lim)` with the over-pressure trip level and the q-current limit (the speed
+//! loop's output, which the reference never exceeds), must stay at or below
+//! `compensation.max_current_a`: a committed table, a scale, a limit or a q-current limit
+//! that would break it is refused naming the bound ([`Compensation::check_amplitude`]), so
+//! the step needs no clamp of its own.
 //!
 //! # Loading
 //!
@@ -98,13 +99,13 @@ pub struct CompensationConfig {
 }
 
 impl CompensationConfig {
-    /// Off, unit scale, 2 A limit (about twice the holding torque's current of the
-    /// nominal rig at 5 MPa).
+    /// Off, unit scale, 3 A limit (a tenth of the q-current limit: room for three times
+    /// the nominal rig's ripples at full current, whose flux harmonics alone are 2 % of it).
     pub const fn nominal() -> CompensationConfig {
         CompensationConfig {
             enabled: false,
             scale: 1.0,
-            max_current_a: 2.0,
+            max_current_a: 3.0,
         }
     }
 
@@ -325,7 +326,7 @@ impl Compensation {
         self.lead_s = cfg.motor.q_inductance_h / cfg.current.kp_q + 1.0 / cfg.rates.pwm_hz.max(1.0);
         self.lead_bins = self.lead_s * BINS_PER_RAD;
         self.p_max_pa = cfg.limits.over_pressure_pa;
-        self.i_max_a = cfg.limits.over_current_a;
+        self.i_max_a = cfg.speed.iq_limit_a;
     }
 
     /// The q-current feed-forward at shaft angle `theta_m` [rad] (in [0, 2π), the
@@ -369,7 +370,7 @@ impl Compensation {
     /// range), refused above `compensation.max_current_a`.
     pub fn check_amplitude(table: &Table, cfg: &crate::Config) -> Result<(), CompensationError> {
         let c = &cfg.compensation;
-        let bound = table.amplitude_bound(cfg.limits.over_pressure_pa, cfg.limits.over_current_a);
+        let bound = table.amplitude_bound(cfg.limits.over_pressure_pa, cfg.speed.iq_limit_a);
         let amplitude_a = c.scale * bound;
         if amplitude_a > c.max_current_a {
             Err(CompensationError::Amplitude {

@@ -63,7 +63,7 @@
 //! | 54 | `sensors.encoder_offset_rad` | rad | 0 | 6.2831855 | 0 |
 //! | 60 | `compensation.enabled` | 1 | 0 | 1 | 0 |
 //! | 61 | `compensation.scale` | 1 | 0 | 2 | 1 |
-//! | 62 | `compensation.max_current_a` | A | 0 | 10 | 2 |
+//! | 62 | `compensation.max_current_a` | A | 0 | 10 | 3 |
 //! | 63 | `compensation.clear` | 1 | 0 | 1 | 0 |
 //!
 //! The table above is checked against the code by this module's tests.

@@ -88,35 +88,38 @@ fn the_feed_forward_scales_each_channel_with_its_regressor() {
 
 #[test]
 fn the_amplitude_bound_is_the_sum_of_the_channel_peaks_over_the_operating_range() {
-    // Peaks 0.5 A, 1e-8 A/Pa, 0.01 A/A at the nominal trips (20 MPa, 45 A):
-    // 0.5 + 0.2 + 0.45 = 1.15 A at unit scale.
+    // Peaks 0.5 A, 1e-8 A/Pa, 0.01 A/A at the nominal trip pressure and q-current limit
+    // (20 MPa, 30 A): 0.5 + 0.2 + 0.3 = 1.0 A at unit scale.
     let mut raw = [[0i16; CHANNELS]; BINS];
     raw[3] = [-16384, 0, 0];
     raw[7] = [0, 10_995, 0];
     raw[9] = [0, 0, 10_486];
     let t = Table::from_raw([15, 40, 20], &raw).unwrap();
     let cfg = Config::nominal();
-    let bound = t.amplitude_bound(cfg.limits.over_pressure_pa, cfg.limits.over_current_a);
-    let want = 0.5 + 10_995.0 / (1u64 << 40) as f32 * 20e6 + 10_486.0 / (1u64 << 20) as f32 * 45.0;
+    let bound = t.amplitude_bound(cfg.limits.over_pressure_pa, cfg.speed.iq_limit_a);
+    let want = 0.5 + 10_995.0 / (1u64 << 40) as f32 * 20e6 + 10_486.0 / (1u64 << 20) as f32 * 30.0;
     assert!(
-        (bound - want).abs() < 1e-5 && (bound - 1.15).abs() < 1e-3,
+        (bound - want).abs() < 1e-5 && (bound - 1.0).abs() < 1e-3,
         "{bound}"
     );
-    // Scale 1.5: 1.72 A ≤ 2 A accepted; scale 2: 2.3 A refused naming the 2 A limit.
-    assert_eq!(Compensation::check_amplitude(&t, &enabled(1.5)), Ok(()));
-    match Compensation::check_amplitude(&t, &enabled(2.0)) {
+    // The nominal 3 A limit: scale 2 (2.0 A) accepted; with the limit lowered to 1.5 A
+    // refused naming it.
+    assert_eq!(Compensation::check_amplitude(&t, &enabled(2.0)), Ok(()));
+    let mut low = enabled(2.0);
+    low.compensation.max_current_a = 1.5;
+    match Compensation::check_amplitude(&t, &low) {
         Err(CompensationError::Amplitude {
             amplitude_a,
             limit_a,
         }) => {
-            assert_eq!(limit_a, 2.0);
+            assert_eq!(limit_a, 1.5);
             assert!((amplitude_a - 2.0 * want).abs() < 1e-4);
         }
         other => panic!("{other:?}"),
     }
     // A refused install leaves an empty table: the drive runs uncompensated.
-    let mut c = Compensation::new(&enabled(2.0));
-    assert!(c.install(&t, &enabled(2.0)).is_err());
+    let mut c = Compensation::new(&low);
+    assert!(c.install(&t, &low).is_err());
     assert!(c.table().is_zero());
     assert_eq!(c.current(0.1, 0.0, 5e6, 1.0), 0.0);
 }

@@ -99,8 +99,18 @@ impl Controller {
                 id,
                 max: next.compensation.scale * limit_a / amplitude_a,
             }),
-            // Nothing else moves the amplitude; a table already over the limit (none can
-            // be committed) does not block unrelated parameters.
+            // The per-current channel's share grows with the q-current limit.
+            ParamId::SpeedIqLimit => {
+                let [c0, cp, ci] = table.peak();
+                let p = next.limits.over_pressure_pa;
+                let room = limit_a / next.compensation.scale.max(f32::MIN_POSITIVE) - c0 - cp * p;
+                Err(ParamError::AboveMaximum {
+                    id,
+                    max: if ci > 0.0 { room / ci } else { 0.0 },
+                })
+            }
+            // Nothing else moves the amplitude (enabling does not: the table was checked
+            // at its commit).
             _ => Ok(()),
         }
     }
