@@ -8,6 +8,7 @@
 //! panics.
 
 use crate::commission::CommissionArgs;
+use crate::compensate::CompensateArgs;
 use crate::diagnose::command::DiagnoseArgs;
 use crate::ingest::IngestArgs;
 use crate::output::paths::{self, Declared};
@@ -58,6 +59,9 @@ pub enum Command {
     Ingest(IngestArgs),
     /// Say what the simulation gets wrong on a bench log, and why.
     Diagnose(DiagnoseArgs),
+    /// Learn the angle-indexed torque feed-forward from bench logs: table, CAN frames,
+    /// predicted pulsation.
+    Compensate(CompensateArgs),
 }
 
 /// Parses the process's arguments, runs, reports; the binary's whole `main`.
@@ -99,6 +103,7 @@ impl Command {
             Command::Tune(a) => a.paths(),
             Command::Ingest(a) => a.paths(),
             Command::Diagnose(a) => a.paths(),
+            Command::Compensate(a) => a.paths(),
         }
     }
 }
@@ -121,6 +126,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Tune(a) => crate::tune::run_tune(&rig, a),
         Command::Ingest(a) => crate::ingest::run_ingest(a),
         Command::Diagnose(a) => crate::diagnose::command::run_diagnose(&rig, a),
+        Command::Compensate(a) => crate::compensate::run_compensate(&rig, a),
     }
 }
 

@@ -389,6 +389,7 @@ pub fn simulate(plant_rig: &Rig, scenario: &Scenario, noise_seed: u64) -> Result
         seed: noise_seed,
         progress: false,
         metadata: vec![("source".into(), "blind-suite".into())],
+        compensation: None,
     };
     Ok(run(plant_rig, &Rig::nominal(), scenario, &opt)?.log)
 }
