@@ -97,6 +97,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
                     seed: 1,
                     progress: false,
                     metadata: m.clone(),
+                    compensation: None,
                 },
             )
         })
@@ -111,6 +112,47 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     let (with, without, stepped, sped) = (next()?, next()?, next()?, next()?);
     let pw = pulsation(&with, hold, &plant);
     let po = pulsation(&without, hold, &plant);
+    // The torque feed-forward learned by the bench procedure (the drive's sweep and a
+    // 12 s hold), then the holding again with it, with and without the absorber.
+    let (ff_table, ff_logs) = crate::compensate::study::bench_learning(rig, &plant, 12.0)?;
+    let ff_runs: Vec<Result<Run, String>> = [(&plant, rig), (&bare, &bare_controller)]
+        .par_iter()
+        .map(|(p, c)| {
+            run(
+                p,
+                c,
+                hold,
+                &RunOptions {
+                    duration_s: 4.0,
+                    log_rate_hz: LOG_RATE_HZ,
+                    seed: 1,
+                    progress: false,
+                    metadata: meta("pressure-hold", "feed-forward"),
+                    compensation: Some(ff_table.clone()),
+                },
+            )
+        })
+        .collect();
+    let mut ff_runs = ff_runs.into_iter();
+    let mut next_ff = || {
+        ff_runs
+            .next()
+            .unwrap_or_else(|| Err("run missing".into()))
+            .map_err(CliError::Failed)
+            .and_then(converged)
+    };
+    let (with_ff, without_ff) = (next_ff()?, next_ff()?);
+    let pwf = pulsation(&with_ff, hold, &plant);
+    let pof = pulsation(&without_ff, hold, &plant);
+    let mut record = [0u8; firmware::compensation::record::RECORD_LEN];
+    firmware::compensation::record::Encoder::write_all(&ff_table, &mut record);
+    crate::output::atomic::write(&out.join("compensation.table"), &record).map_err(|source| {
+        CliError::Write {
+            file: out.join("compensation.table"),
+            source,
+        }
+    })?;
+    write_log(&out.join("compensation-sweep.csv"), &ff_logs[0])?;
 
     let log_path = out.join("pressure-hold.csv");
     write_log(&log_path, &with.log)?;
@@ -134,12 +176,12 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         "cause (order per rev)",
         "shaft"
     );
+    let fitted = format!("fitted, p0 {:.1} MPa", rig.absorber.precharge_pa / 1e6);
     for (label, p) in [
-        (
-            format!("fitted, p0 {:.1} MPa", rig.absorber.precharge_pa / 1e6),
-            &pw,
-        ),
+        (fitted.clone(), &pw),
         ("none".to_string(), &po),
+        ("none + feed-forward".to_string(), &pof),
+        (format!("{fitted} + ff"), &pwf),
     ] {
         let cause = match p.cause {
             Some(s) => format!("{} ({:.0})", s.cause, s.order),
@@ -169,6 +211,14 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         table,
         "\nabsorption {absorption:.0} %; absorber natural frequency {:.1} Hz, damping ratio {:.2} at the holding pressure; {:.0}× real time",
         with.absorber_fn_hz, with.absorber_zeta, with.real_time_factor
+    );
+    let cut =
+        |without: f64, with: f64| crate::compensate::predict::reduction_percent(without, with);
+    let _ = writeln!(
+        table,
+        "torque feed-forward (learned by the bench sweep and a 12 s hold, compensation.table): pulsation {:.0} % less without the absorber, {:.0} % less with it; the rest is the pump's flow ripple and the loop's wander (docs/compensation.md)",
+        cut(po.pp_pa, pof.pp_pa),
+        cut(pw.pp_pa, pwf.pp_pa)
     );
 
     // Plots.
@@ -203,6 +253,10 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             "p [MPa]",
             &[
                 Series {
+                    name: "measured (transducer), absorber fitted",
+                    points: trace(&with, true),
+                },
+                Series {
                     name: "true, absorber fitted",
                     points: trace(&with, false),
                 },
@@ -211,8 +265,8 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
                     points: trace(&without, false),
                 },
                 Series {
-                    name: "measured (transducer), absorber fitted",
-                    points: trace(&with, true),
+                    name: "true, no absorber, torque feed-forward",
+                    points: trace(&without_ff, false),
                 },
             ],
             &[],
@@ -338,7 +392,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     )?;
     let _ = writeln!(
         table,
-        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, pressure_trace.svg, pulsation_spectrum.svg, pressure_step.svg, speed_step.svg",
+        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, compensation-sweep.csv, compensation.table, pressure_trace.svg, pulsation_spectrum.svg, pressure_step.svg, speed_step.svg",
         out.display()
     );
     print_stdout(&table)
