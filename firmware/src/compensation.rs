@@ -411,15 +411,8 @@ impl Compensation {
         cfg: &crate::Config,
     ) -> Result<(), CompensationError> {
         self.loader = None;
-        let result = record::read(len, read, &mut self.table)
-            .map_err(CompensationError::Record)
-            .and_then(|()| Compensation::check_amplitude(&self.table, cfg));
-        if result.is_err() {
-            self.table = Table::ZERO;
-        }
-        self.committed = true;
-        self.retune(cfg);
-        result
+        let result = record::read(len, read, &mut self.table).map_err(CompensationError::Record);
+        self.settle(result, cfg)
     }
 
     /// Empties the table (committed, zero amplitude).
@@ -468,10 +461,18 @@ impl Compensation {
         let Some(l) = self.loader.take() else {
             return Err(CompensationError::Record(record::RecordError::NotLoading));
         };
-        let result = l
-            .finish(crc)
-            .map_err(CompensationError::Record)
-            .and_then(|()| Compensation::check_amplitude(&self.table, cfg));
+        let result = l.finish(crc).map_err(CompensationError::Record);
+        self.settle(result, cfg)
+    }
+
+    /// Ends a load that arrived in place as `arrived`: its amplitude checked under `cfg`,
+    /// the table emptied on any refusal, committed either way.
+    fn settle(
+        &mut self,
+        arrived: Result<(), CompensationError>,
+        cfg: &crate::Config,
+    ) -> Result<(), CompensationError> {
+        let result = arrived.and_then(|()| Compensation::check_amplitude(&self.table, cfg));
         if result.is_err() {
             self.table = Table::ZERO;
         }

@@ -4,7 +4,9 @@
 //! refused at boot with fault 19 when its stored record is wrong (the drive then runs
 //! uncompensated), and acting in Speed and Pressure only.
 
-use embedded_storage::nor_flash::{ErrorType, NorFlash, NorFlashErrorKind, ReadNorFlash};
+mod common;
+
+use common::RamFlash;
 use firmware::can_protocol::{
     decode_command, encode_command, encode_set_parameter, NodeId, RejectReason, Reply, Request,
 };
@@ -178,39 +180,6 @@ fn the_feed_forward_acts_in_speed_and_pressure_only() {
     set(&mut c, ParamId::CompensationClear, 1.0);
     assert!(c.compensation().table().is_zero());
     assert_eq!(c.parameter(ParamId::CompensationClear), 0.0);
-}
-
-/// A RAM NOR flash with the G4's page and programming unit.
-struct RamFlash(Vec<u8>);
-
-impl ErrorType for RamFlash {
-    type Error = NorFlashErrorKind;
-}
-
-impl ReadNorFlash for RamFlash {
-    const READ_SIZE: usize = 1;
-    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
-        let at = offset as usize;
-        bytes.copy_from_slice(&self.0[at..at + bytes.len()]);
-        Ok(())
-    }
-    fn capacity(&self) -> usize {
-        self.0.len()
-    }
-}
-
-impl NorFlash for RamFlash {
-    const WRITE_SIZE: usize = 8;
-    const ERASE_SIZE: usize = 2048;
-    fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
-        self.0[from as usize..to as usize].fill(0xFF);
-        Ok(())
-    }
-    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
-        let at = offset as usize;
-        self.0[at..at + bytes.len()].copy_from_slice(bytes);
-        Ok(())
-    }
 }
 
 const SLOT: u32 = 4096;

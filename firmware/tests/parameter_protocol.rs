@@ -4,7 +4,9 @@
 //! set/get round trip, every out-of-range set refused naming the parameter and the bound,
 //! and a table set over CAN, saved, and found again after a reboot.
 
-use embedded_storage::nor_flash::{ErrorType, NorFlash, NorFlashErrorKind, ReadNorFlash};
+mod common;
+
+use common::RamFlash;
 use firmware::can_protocol::{
     decode_command, decode_reply, encode_command, encode_get_parameter, encode_reply,
     encode_set_parameter, Frame, NodeId, RejectReason, Rejection, Reply, Request,
@@ -185,39 +187,6 @@ fn the_set_parameter_frame_is_the_documented_layout() {
 
 fn f_text(id: ParamId, value: f32) -> String {
     encode_set_parameter(id, value, node()).to_string()
-}
-
-/// A RAM NOR flash for the save path (the power-cut tests are in `param_store`).
-struct RamFlash(Vec<u8>);
-
-impl ErrorType for RamFlash {
-    type Error = NorFlashErrorKind;
-}
-
-impl ReadNorFlash for RamFlash {
-    const READ_SIZE: usize = 1;
-    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
-        let at = offset as usize;
-        bytes.copy_from_slice(&self.0[at..at + bytes.len()]);
-        Ok(())
-    }
-    fn capacity(&self) -> usize {
-        self.0.len()
-    }
-}
-
-impl NorFlash for RamFlash {
-    const WRITE_SIZE: usize = 8;
-    const ERASE_SIZE: usize = 2048;
-    fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
-        self.0[from as usize..to as usize].fill(0xFF);
-        Ok(())
-    }
-    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
-        let at = offset as usize;
-        self.0[at..at + bytes.len()].copy_from_slice(bytes);
-        Ok(())
-    }
 }
 
 #[test]
