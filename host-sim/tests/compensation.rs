@@ -3,7 +3,8 @@
 //! from the logs, and on the paper's holding at 5 MPa without the absorber the table takes
 //! at least 70 % off the shaft speed's pulsation (the target; the pressure's is
 //! reported in `docs/compensation.md`). A table file of the wrong size or CRC is refused
-//! by `eha simulate --compensation` before any work, exit 2, naming the file.
+//! by `eha simulate --compensation` before any work, exit 2, naming the file; `eha
+//! compensate` refuses a log without the angle and an effect that is not angle-locked.
 
 mod common;
 
@@ -125,5 +126,51 @@ fn a_table_file_of_the_wrong_size_or_crc_is_refused_naming_it() {
             "{why}: {err}"
         );
         assert!(!out.exists(), "nothing written");
+    }
+}
+
+#[test]
+fn eha_compensate_refuses_a_log_without_the_angle_and_an_unknown_effect() {
+    let dir = common::scratch("compensation", "bad-learning");
+    let log = dir.join("hold.csv");
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "1",
+        "--out",
+        s(&log),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut l = host_sim::bench_log::read(&log).unwrap();
+    l.theta_m_rad = None;
+    let blind = dir.join("no-angle.csv");
+    host_sim::bench_log::write(&blind, &l).unwrap();
+    let table = dir.join("t.table");
+    for (args, named) in [
+        (
+            vec!["compensate", s(&blind), "--out", s(&table)],
+            vec![s(&blind), "theta_m_rad"],
+        ),
+        (
+            vec![
+                "compensate",
+                s(&log),
+                "--out",
+                s(&table),
+                "--exclude",
+                "dead_time",
+            ],
+            vec!["--exclude", "dead_time", "cogging_torque"],
+        ),
+    ] {
+        let o = eha(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        for n in named {
+            assert!(err.contains(n), "{n}: {err}");
+        }
+        assert!(!table.exists(), "nothing written");
     }
 }
