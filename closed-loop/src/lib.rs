@@ -7,6 +7,10 @@
 //! duties held (zero-order hold). Nothing of the plant's state reaches the controller except
 //! through [`plant_model::SensorReadings`] → [`firmware::io::Measurements`].
 //!
+//! The plant's hardware over-current break ([`plant_model::Plant::set_hardware_break`], off
+//! unless armed) is reported to the control core as the board's break interrupt does, before
+//! the next current-loop call.
+//!
 //! `no_std`: the same harness runs in `eha`, in the cross-crate tests, and in the PIL binary
 //! on a Cortex-M4F.
 #![no_std]
@@ -44,6 +48,7 @@ fn record(plant: &Plant, controller: &Controller, outputs: Outputs) -> Sample {
 }
 
 /// The control core in closed loop with the plant.
+#[derive(Clone)]
 pub struct ClosedLoop {
     plant: Plant,
     controller: Controller,
@@ -53,6 +58,7 @@ pub struct ClosedLoop {
     heartbeat_every: u32,
     steps: u64,
     external_torque_nm: f64,
+    bench_pc: bool,
 }
 
 /// Why a closed loop could not be built.
@@ -104,6 +110,7 @@ impl ClosedLoop {
             heartbeat_every,
             steps: 0,
             external_torque_nm: 0.0,
+            bench_pc: true,
         })
     }
 
@@ -122,9 +129,25 @@ impl ClosedLoop {
         &self.plant
     }
 
+    /// The plant (for fault injection: [`Plant::set_faults`], [`Plant::set_sensor_faults`]).
+    pub fn plant_mut(&mut self) -> &mut Plant {
+        &mut self.plant
+    }
+
     /// The controller (for commands outside the scenario, fault injection, telemetry).
     pub fn controller_mut(&mut self) -> &mut Controller {
         &mut self.controller
+    }
+
+    /// Switches the harness's own bench PC (the scenario's commands and the heartbeats) on
+    /// or off; off, every command comes from the caller (a CAN bus model, say).
+    pub fn set_bench_pc(&mut self, on: bool) {
+        self.bench_pc = on;
+    }
+
+    /// The scenario this loop runs.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
     }
 
     /// Sends a command as the bench PC would; refused commands are returned.
@@ -165,7 +188,12 @@ impl ClosedLoop {
         record: impl FnOnce(&Plant, &Controller, Outputs) -> R,
     ) -> R {
         let t = self.time_s();
-        while let Some(ev) = self.scenario.events.get(self.next_event) {
+        while let Some(ev) = self
+            .scenario
+            .events
+            .get(self.next_event)
+            .filter(|_| self.bench_pc)
+        {
             match ev {
                 Some((at, cmd)) if *at <= t => {
                     // Scenario commands are within range by construction; a refusal shows in
@@ -179,7 +207,7 @@ impl ClosedLoop {
                 }
             }
         }
-        if self.steps % self.heartbeat_every as u64 == 0 {
+        if self.bench_pc && self.steps % self.heartbeat_every as u64 == 0 {
             let _ = self.controller.command(Command::Heartbeat);
         }
         let r = self.plant.sample();
@@ -198,6 +226,9 @@ impl ClosedLoop {
         let mut inputs = Inputs::duties([d[0] as f64, d[1] as f64, d[2] as f64], out.pwm_enabled);
         inputs.external_torque_nm = self.external_torque_nm;
         self.plant.advance(self.period_s, &inputs);
+        if self.plant.take_break_event() {
+            self.controller.report_hardware_break();
+        }
         self.steps += 1;
         recorded
     }

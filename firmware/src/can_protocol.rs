@@ -920,14 +920,18 @@ pub fn acceptance_filters(node: NodeId) -> [(u16, u16); 2] {
 }
 
 /// Decodes a command frame addressed to `node`.
+///
+/// A frame addressed to another node is [`DecodeError::OtherNode`] whatever its function
+/// (another drive's status or reject included), so the drive never answers it: only its
+/// own node's unknown functions get a reject.
 pub fn decode_command(frame: &Frame, node: NodeId) -> Result<Request, DecodeError> {
     let frame_node = (frame.id & NODE_MASK) as u8;
     let base = frame.id & !NODE_MASK;
-    let function =
-        Function::from_base(base).ok_or(DecodeError::UnknownFunction { id: frame.id })?;
     if frame_node != node.0 {
         return Err(DecodeError::OtherNode { node: frame_node });
     }
+    let function =
+        Function::from_base(base).ok_or(DecodeError::UnknownFunction { id: frame.id })?;
     let payload = frame.payload();
     let expected = function.dlc();
     if payload.len() != usize::from(expected) {

@@ -186,6 +186,15 @@ pub struct FaultLimits {
     pub encoder_plausible_speed_rad_s: f32,
     /// Time without any command before the command-timeout fault (active modes only). [s]
     pub command_timeout_s: f32,
+    /// Largest magnitude of the sum of the three phase currents (zero in a star without a
+    /// neutral): above it a current channel is wrong or current leaves the star through a
+    /// short to a rail or earth ([`crate::plausibility`]). Until the current offsets are
+    /// measured (a calibration's first phase), three times the offset tolerance
+    /// (`calibration.offset_max_lsb`) is allowed besides. [A]
+    pub current_sum_a: f32,
+    /// Time the q-current reference may sit at its limit with the shaft measured below a
+    /// tenth of the speed limit before the stall fault ([`crate::plausibility`]). [s]
+    pub stall_time_s: f32,
 }
 
 /// Calibration sequence (mode Calibrating).
@@ -364,6 +373,13 @@ impl Config {
                 over_speed_rad_s: 260.0,
                 encoder_plausible_speed_rad_s: 600.0,
                 command_timeout_s: 0.1,
+                // A tenth of the q-current limit: 75 times the sum's noise (three
+                // channels at 0.02 A rms and a count each, 0.04 A rms) and three times what
+                // a 2 % gain mismatch of one channel makes at the 45 A trip.
+                current_sum_a: 3.0,
+                // Ten times the longest saturated acceleration of the loaded shaft
+                // (0 -> 200 rad/s at 30 A: 5 ms).
+                stall_time_s: 0.1,
             },
             calibration: CalibrationConfig {
                 offset_time_s: 0.05,
@@ -619,6 +635,11 @@ impl Config {
         if l.command_timeout_s > 3600.0 {
             return Err(err("limits.command_timeout_s", "must be at most 3600 s"));
         }
+        positive("limits.current_sum_a", l.current_sum_a)?;
+        positive("limits.stall_time_s", l.stall_time_s)?;
+        if l.stall_time_s > 3600.0 {
+            return Err(err("limits.stall_time_s", "must be at most 3600 s"));
+        }
 
         let k = &self.calibration;
         positive("calibration.offset_time_s", k.offset_time_s)?;
@@ -677,7 +698,7 @@ mod tests {
     #[test]
     fn each_bad_field_is_named() {
         type Case = (fn(&mut Config), &'static str);
-        let cases: [Case; 23] = [
+        let cases: [Case; 25] = [
             (
                 |c| c.limits.hardware_over_current_a = 44.0,
                 "limits.hardware_over_current_a",
@@ -753,6 +774,11 @@ mod tests {
                 |c| c.limits.command_timeout_s = -1.0,
                 "limits.command_timeout_s",
             ),
+            (
+                |c| c.limits.current_sum_a = f32::NAN,
+                "limits.current_sum_a",
+            ),
+            (|c| c.limits.stall_time_s = 0.0, "limits.stall_time_s"),
         ];
         for (mutate, field) in cases {
             let mut c = Config::nominal();

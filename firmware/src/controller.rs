@@ -35,6 +35,7 @@ use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
 use crate::io::{Measurements, Outputs};
 use crate::parameters::{self, ParamError, ParamId, TableError, COUNT};
 use crate::pi::saturate;
+use crate::plausibility::{current_sum_off, StallMonitor};
 use crate::pressure_loop::PressureLoop;
 use crate::speed_loop::SpeedLoop;
 use crate::speed_observer::SpeedObserver;
@@ -268,6 +269,7 @@ pub struct Controller {
     iq_ff: f32,
     /// The feed-forward's bench sweep, while it runs.
     sweep: Option<Sweep>,
+    stall: StallMonitor,
 }
 
 impl Controller {
@@ -346,6 +348,7 @@ impl Controller {
             compensation: Compensation::new(config),
             iq_ff: 0.0,
             sweep: None,
+            stall: StallMonitor::new(config.limits.stall_time_s, pwm),
         }
     }
 
@@ -441,6 +444,12 @@ impl Controller {
     /// True once a calibration has completed.
     pub fn is_calibrated(&self) -> bool {
         self.calibrated
+    }
+
+    /// True once the current offsets in use were measured in this power cycle (at boot or
+    /// by a calibration's first phase), or the configuration trusts its zero.
+    pub fn offsets_measured(&self) -> bool {
+        self.offsets_measured
     }
 
     /// Zero-current ADC results in use. [counts]
@@ -668,6 +677,28 @@ impl Controller {
             FaultCode::CommandTimeout,
             mode.is_active() && self.since_command > self.d.timeout_calls,
         );
+        // Until the offsets are measured each channel may be off by the calibration's
+        // tolerance.
+        // A calibration measures the offsets again: until it has, a bad one is its
+        // CurrentOffset, so the sum allows for unmeasured offsets meanwhile.
+        let offsets_a = if self.offsets_measured && mode != Mode::Calibrating {
+            0.0
+        } else {
+            3.0 * self.cfg.calibration.offset_max_lsb * s.current_a_per_lsb
+        };
+        conditions.set(
+            FaultCode::PhaseCurrentSum,
+            current_sum_off(&self.state.i_abc, l.current_sum_a + offsets_a),
+        );
+        let sp = &self.cfg.speed;
+        let stalled = self.stall.update(
+            matches!(mode, Mode::Speed | Mode::Pressure),
+            self.iq_ref,
+            sp.iq_limit_a,
+            self.speed.speed(),
+            sp.speed_limit_rad_s,
+        );
+        conditions.set(FaultCode::Stall, stalled);
 
         let still_on = self.sup.check(conditions);
         self.active_last_call = self.sup.mode().is_active();

@@ -25,6 +25,7 @@ pub mod io;
 pub mod param_store;
 pub mod parameters;
 pub mod pi;
+pub mod plausibility;
 pub mod pressure_loop;
 pub mod scaling;
 pub mod shunt;

@@ -21,7 +21,7 @@
 //! data word but before the commit is not taken either. The feed-forward table of the
 //! record loaded is checked on its own ([`ParamStore::read_table`] feeds
 //! [`crate::Controller::load_compensation_record`]): a wrong size, version or CRC refuses
-//! the table alone (fault 19), the parameters still load. The sequence number
+//! the table alone (fault 21), the parameters still load. The sequence number
 //! (newer = larger, counted with wrap-around) decides between two valid slots. Two slots cost
 //! twice the record's pages of flash; a log-structured store (e.g. `sequential-storage`) would
 //! level wear, but the

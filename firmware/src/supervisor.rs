@@ -105,15 +105,23 @@ pub enum FaultCode {
     /// DBANK cleared): nothing was loaded, the defaults are in use and saves are refused.
     /// (18)
     ParameterFlashLayout = 18,
+    /// The three phase currents do not sum to zero within `limits.current_sum_a`: a current
+    /// channel stuck, off in gain or clipping, or current leaving the star through a short
+    /// to a rail or earth. (19)
+    PhaseCurrentSum = 19,
+    /// The q-current reference at its limit for `limits.stall_time_s` with the shaft
+    /// measured below a tenth of the speed limit: a locked rotor, or an encoder that does
+    /// not see the shaft turn (stuck, reversed). (20)
+    Stall = 20,
     /// The stored torque feed-forward table was refused (wrong size, format version or
     /// CRC, or an amplitude above `compensation.max_current_a`): the drive runs
-    /// uncompensated. (19)
-    CompensationTableInvalid = 19,
+    /// uncompensated. (21)
+    CompensationTableInvalid = 21,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 19] = [
+    pub const ALL: [FaultCode; 21] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -132,6 +140,8 @@ impl FaultCode {
         FaultCode::ParameterStoreInvalid,
         FaultCode::HardwareBreak,
         FaultCode::ParameterFlashLayout,
+        FaultCode::PhaseCurrentSum,
+        FaultCode::Stall,
         FaultCode::CompensationTableInvalid,
     ];
 
@@ -168,6 +178,7 @@ impl FaultCode {
                 | FaultCode::ParameterStoreInvalid
                 | FaultCode::HardwareBreak
                 | FaultCode::ParameterFlashLayout
+                | FaultCode::Stall
                 | FaultCode::CompensationTableInvalid
         )
     }
@@ -200,6 +211,10 @@ impl fmt::Display for FaultCode {
             FaultCode::ParameterFlashLayout => {
                 "flash not dual-bank (DBANK option bit): parameter store unavailable"
             }
+            FaultCode::PhaseCurrentSum => {
+                "phase currents do not sum to zero (current sensor or earth fault)"
+            }
+            FaultCode::Stall => "stall: current at its limit, shaft not turning",
             FaultCode::CompensationTableInvalid => {
                 "stored torque feed-forward table refused, running uncompensated"
             }
@@ -436,7 +451,7 @@ mod tests {
             seen |= f.bit();
         }
         assert_eq!(FaultCode::from_code(0), None);
-        // Code 16 is the documented parameter-store fault.
+        // Code 16 is the documented parameter-store fault, 17 the hardware break.
         assert_eq!(
             FaultCode::from_code(16),
             Some(FaultCode::ParameterStoreInvalid)
@@ -447,6 +462,8 @@ mod tests {
         }
         assert_eq!(usize::from(FaultCode::MAX_CODE), FaultCode::ALL.len());
         assert_eq!(FaultCode::from_code(FaultCode::MAX_CODE + 1), None);
+        assert_eq!(FaultCode::from_code(17), Some(FaultCode::HardwareBreak));
+        assert_eq!(FaultCode::from_code(20), Some(FaultCode::Stall));
         for m in [
             Mode::Disabled,
             Mode::Calibrating,
@@ -478,6 +495,46 @@ mod tests {
         assert_eq!(s.clear(), Ok(()));
         assert_eq!(s.fault(), None);
         assert_eq!(s.mode(), Mode::Disabled);
+    }
+
+    #[test]
+    fn a_hardware_break_latches_its_own_code_until_cleared() {
+        use crate::{Command, Config, Controller, Measurements};
+        let healthy = Measurements {
+            adc_phase_current: [2048; 3],
+            adc_dc_link: 2800,
+            adc_pressure: 6554 + 6291, // 3 MPa
+            ..Measurements::default()
+        };
+        let mut c = Controller::new(&Config::nominal());
+        // Power-up: the offsets measured at rest, then the encoder index passes.
+        for _ in 0..1000 {
+            c.on_current_sample(&healthy);
+        }
+        c.on_current_sample(&Measurements {
+            encoder_index: true,
+            ..healthy
+        });
+        c.command(Command::SetMode(Mode::Speed)).unwrap();
+        assert!(c.on_current_sample(&healthy).pwm_enabled);
+        // The break interrupt between two current-loop calls.
+        c.report_hardware_break();
+        assert_eq!(c.fault(), Some(FaultCode::HardwareBreak));
+        assert_eq!(c.telemetry().fault.map(FaultCode::code), Some(17));
+        for _ in 0..10 {
+            assert!(!c.on_current_sample(&healthy).pwm_enabled);
+            c.command(Command::Heartbeat).unwrap();
+        }
+        assert_eq!(
+            c.command(Command::SetMode(Mode::Speed)),
+            Err(crate::CommandError::Mode(ModeRefusal::Faulted(
+                FaultCode::HardwareBreak
+            )))
+        );
+        // The comparators' cause is not visible to the core: the clear is the operator's.
+        c.command(Command::ClearFaults).unwrap();
+        c.command(Command::SetMode(Mode::Speed)).unwrap();
+        assert!(c.on_current_sample(&healthy).pwm_enabled);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The torque feed-forward end to end on the host, through the code the MCU application
 //! runs: a table loaded over CAN and committed, refused naming the bound when its
 //! amplitude (or a scale, or a limit) breaks the limit, saved and found after a reboot,
-//! refused at boot with fault 19 when its stored record is wrong (the drive then runs
+//! refused at boot with fault 21 when its stored record is wrong (the drive then runs
 //! uncompensated), and acting in Speed and Pressure only.
 
 mod common;

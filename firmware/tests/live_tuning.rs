@@ -24,7 +24,11 @@ fn at_rest() -> Measurements {
 }
 
 fn running(mode: Mode) -> Controller {
-    let mut c = Controller::new(&Config::nominal());
+    // The encoder stands still while the loops ask for torque, for seconds: a stall to the
+    // supervisor, which these tests of the loops' arithmetic keep out of the way.
+    let mut cfg = Config::nominal();
+    cfg.limits.stall_time_s = 3600.0;
+    let mut c = Controller::new(&cfg);
     // Power-up as on the board: the current offsets measured at rest (0.05 s at 20 kHz),
     // then the encoder index passes (captured at counter 0).
     for _ in 0..1000 {

@@ -91,18 +91,55 @@ pub fn amplitude_spectrum(x: &[f64], dt_s: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// The strongest spectral line above `min_hz`, and the source whose order it matches
-/// (within ±8 % of the order, or ±1.5 bins) at shaft speed `shaft_rev_per_s`.
+/// How far a line must stand above the median of its neighbourhood to be one. The
+/// Hann-windowed amplitude of a noise bin is Rayleigh distributed, P(A > k·median) =
+/// 2^(−k²); the strongest of N noise bins passes k with probability below N·2^(−k²), 1e-3
+/// for 4.5 and the few thousand bins of a pulsation spectrum.
+pub const LINE_OVER_FLOOR: f64 = 4.5;
+/// Bins on each side of a candidate whose median is its noise floor (the two next to it,
+/// where a Hann-windowed line leaks, left out).
+const FLOOR_BINS: usize = 12;
+
+/// The median amplitude of the bins around `k` (±[`FLOOR_BINS`], without k ± 2).
+fn noise_floor(spectrum: &[(f64, f64)], k: usize) -> f64 {
+    let lo = k.saturating_sub(FLOOR_BINS);
+    let hi = (k + FLOOR_BINS + 1).min(spectrum.len());
+    let mut around: Vec<f64> = (lo..hi)
+        .filter(|j| j.abs_diff(k) > 2)
+        .map(|j| spectrum[j].1)
+        .collect();
+    if around.is_empty() {
+        return 0.0;
+    }
+    around.sort_by(f64::total_cmp);
+    around[around.len() / 2]
+}
+
+/// The strongest spectral line above `min_hz` — a bin standing [`LINE_OVER_FLOOR`] times
+/// above its neighbourhood's median — and the source whose order it matches (within ±8 %
+/// of the order, or ±1.5 bins) at shaft speed `shaft_rev_per_s`. When no bin is a line the
+/// strongest bin is returned without a source: the pulsation is broadband there (in closed
+/// loop, the pressure loop following its transducer's noise within its bandwidth), and
+/// naming the order a noise bump happens to fall on would be a false attribution.
 pub fn dominant_line(
     spectrum: &[(f64, f64)],
     min_hz: f64,
     shaft_rev_per_s: f64,
     sources: &[Source],
 ) -> Option<(f64, f64, Option<Source>)> {
-    let &(f, a) = spectrum
-        .iter()
-        .filter(|(f, _)| *f >= min_hz)
-        .max_by(|x, y| x.1.total_cmp(&y.1))?;
+    let above = || {
+        spectrum
+            .iter()
+            .enumerate()
+            .filter(|(_, (f, _))| *f >= min_hz)
+    };
+    let line = above()
+        .filter(|(k, (_, a))| *a > LINE_OVER_FLOOR * noise_floor(spectrum, *k))
+        .max_by(|x, y| x.1 .1.total_cmp(&y.1 .1));
+    let Some((_, &(f, a))) = line else {
+        let (_, &(f, a)) = above().max_by(|x, y| x.1 .1.total_cmp(&y.1 .1))?;
+        return Some((f, a, None));
+    };
     let df = spectrum.first().map(|p| p.0).unwrap_or(0.0);
     let cause = sources
         .iter()
@@ -141,5 +178,49 @@ mod tests {
         assert!((f - 18.0).abs() < 0.6, "{f}");
         assert!((a - 3.0).abs() < 0.1, "{a}");
         assert_eq!(cause.unwrap().cause, "piston ripple");
+    }
+
+    /// Gaussian noise (Box–Muller on a xorshift) through a first-order low-pass at
+    /// `corner_hz`, sampled at 2 kHz for 3 s, plus a sine of `amp` at `f_hz`.
+    fn noise_and_sine(seed: u64, corner_hz: f64, f_hz: f64, amp: f64) -> Vec<f64> {
+        let mut state = seed | 1;
+        let mut unit = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let dt = 1.0 / 2000.0;
+        let a = (-2.0 * std::f64::consts::PI * corner_hz * dt).exp();
+        let mut y = 0.0;
+        (0..6000)
+            .map(|i| {
+                let n = (-2.0 * (1.0 - unit()).ln()).sqrt()
+                    * (2.0 * std::f64::consts::PI * unit()).cos();
+                y = a * y + (1.0 - a) * 1000.0 * n;
+                let t = i as f64 * dt;
+                5e6 + y + amp * (2.0 * std::f64::consts::PI * f_hz * t).sin()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn broadband_noise_is_not_attributed_to_the_order_it_peaks_at() {
+        // Noise below a 3 Hz corner (a pressure loop following its transducer) peaks
+        // somewhere below 4 Hz, often within a bin or two of a 0.9 rev/s shaft's first
+        // order: no line there, so no cause, for every seed.
+        let rig = Rig::nominal();
+        for seed in 1..=20 {
+            let x = noise_and_sine(seed, 3.0, 0.0, 0.0);
+            let s = amplitude_spectrum(&x, 1.0 / 2000.0);
+            let (f, _, cause) = dominant_line(&s, 0.5, 0.9, &sources(&rig)).unwrap();
+            assert!(cause.is_none(), "seed {seed}: {f} Hz named {cause:?}");
+        }
+        // The same noise with a real line at the shaft frequency, 5 times the noise's
+        // amplitude per bin: named.
+        let x = noise_and_sine(3, 3.0, 0.9, 300.0);
+        let s = amplitude_spectrum(&x, 1.0 / 2000.0);
+        let (f, _, cause) = dominant_line(&s, 0.5, 0.9, &sources(&rig)).unwrap();
+        assert_eq!(cause.map(|c| c.order), Some(1.0), "{f} Hz");
     }
 }

@@ -62,6 +62,10 @@ fn param(v: &Value, name: &str) -> f64 {
     v["causes"][0]["parameters"][name].as_f64().unwrap()
 }
 
+fn noise_ratio(v: &Value, model: &str, signal: &str) -> f64 {
+    v[model]["noise_ratio_by_signal"][signal].as_f64().unwrap()
+}
+
 fn gain(v: &Value, signal: &str) -> f64 {
     v["extended"]["fit_percent_by_signal"][signal]
         .as_f64()
@@ -99,8 +103,26 @@ fn a_nominal_rig_is_explained_by_the_nominal_model() {
     }
     assert!(v["gain"]["fit_points"].is_number());
     assert!(v["gain"]["rmse_reduction_percent"].is_number());
-    // Every catalogue effect the log can show is ranked, `none` first.
-    assert!(v["causes"].as_array().unwrap().len() >= 10);
+    // Every effect whose relation the log supports is ranked: the hydraulic ones (the
+    // shaft angle and the pressure are logged), shaft friction (the torque balance), dead
+    // time (the voltages are logged). The angle-locked lines need steady rotation, which
+    // the holding's limit cycle around 1 rev/s does not give within 10 %.
+    let ranked: Vec<&str> = v["causes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|c| c["effect"].as_str())
+        .collect();
+    for effect in [
+        "extra_leakage",
+        "entrained_air",
+        "accumulator_precharge",
+        "pressure_sensor_lag",
+        "shaft_friction",
+        "dead_time",
+    ] {
+        assert!(ranked.contains(&effect), "{effect} not ranked: {ranked:?}");
+    }
     assert!(report.join("report.md").exists());
 }
 
@@ -133,7 +155,14 @@ fn a_gas_loss_in_the_absorber_is_named_and_measured() {
     assert_eq!(lead(&v), "accumulator_precharge", "{v:#}");
     let p0 = param(&v, "precharge_pa");
     assert!((p0 / 1.8e6 - 1.0).abs() < 0.2, "{p0}");
-    assert!(gain(&v, "p_pa") >= 10.0, "{v:#}");
+    // On the validation segment the extended model explains the pressure down to twice
+    // its noise at most, and at least halves what the calibrated baseline leaves.
+    let (base, ext) = (
+        noise_ratio(&v, "baseline", "p_pa"),
+        noise_ratio(&v, "extended", "p_pa"),
+    );
+    assert!(ext < 2.0 && ext < 0.5 * base, "{base} → {ext}");
+    assert!(gain(&v, "p_pa") > 0.0, "{v:#}");
 }
 
 #[test]
@@ -155,23 +184,15 @@ fn a_transducer_lag_shows_as_its_phase_delay_at_the_payload_resonance() {
         .find(|g| g.signal == "p_pa")
         .expect("the pressure's signature");
     let omega_h = (2.0 * 6.5e8 * 71e-4f64.powi(2) / (450e-6 * 2000.0)).sqrt();
-    let expected = (omega_h * 7e-3).atan() / omega_h;
-    // One log row (1 ms) of resolution.
-    assert!(
-        (p.lag_s - expected).abs() <= 1.0e-3,
-        "{} vs {expected}",
-        p.lag_s
-    );
-    // A lag is the evidence the ranking quotes for it.
-    let cause = a
-        .diagnosis
-        .causes
-        .iter()
-        .find(|c| c.effect == "pressure_sensor_lag")
-        .expect("ranked");
-    assert!(
-        cause.evidence.contains("lags the model by"),
-        "{}",
-        cause.evidence
-    );
+    let delay = |tau: f64| (omega_h * tau).atan() / omega_h;
+    // The baseline is calibrated with the transducer's own lag anywhere in its 0–2.5 ms
+    // band, so its residual lags it by between delay(7 ms) − delay(2.5 ms) and delay(7 ms);
+    // one log row (1 ms) of resolution either side.
+    let (lo, hi) = (delay(7e-3) - delay(2.5e-3) - 1e-3, delay(7e-3) + 1e-3);
+    assert!((lo..=hi).contains(&p.lag_s), "{} not in {lo}…{hi}", p.lag_s);
+    // Released, the lag is named and measured.
+    let first = &a.diagnosis.causes[0];
+    assert_eq!(first.effect, "pressure_sensor_lag", "{}", first.evidence);
+    let tau = first.parameters["time_constant_s"];
+    assert!((tau / 7e-3 - 1.0).abs() < 0.2, "{tau}");
 }

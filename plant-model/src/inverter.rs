@@ -23,6 +23,8 @@ const SQRT3: f64 = 1.732_050_807_568_877_2;
 pub struct Inverter {
     /// U_dc. [V]
     pub u_dc_v: f64,
+    /// Dead-time voltage error at full current over U_dc, t_d·f_pwm. [1]
+    dead_time_fraction: f64,
     /// Dead-time voltage error at full current, t_d·f_pwm·U_dc. [V]
     dead_time_error_v: f64,
     /// Current band of the dead-time sign. [A]
@@ -34,15 +36,26 @@ impl Inverter {
     pub fn new(p: &InverterParams) -> Inverter {
         Inverter {
             u_dc_v: p.u_dc_v,
+            dead_time_fraction: p.dead_time_s * p.pwm_frequency_hz,
             dead_time_error_v: p.dead_time_s * p.pwm_frequency_hz * p.u_dc_v,
             band_a: p.dead_time_current_band_a,
+        }
+    }
+
+    /// Takes a new DC-link voltage (a supply fault's bus voltage), scaling the dead-time
+    /// error with it. [V]
+    #[inline]
+    pub fn set_u_dc(&mut self, u_dc_v: f64) {
+        if u_dc_v != self.u_dc_v {
+            self.u_dc_v = u_dc_v;
+            self.dead_time_error_v = self.dead_time_fraction * u_dc_v;
         }
     }
 
     /// Whether the dead-time error is modelled (then the pole voltages depend on the currents).
     #[inline]
     pub fn has_dead_time(&self) -> bool {
-        self.dead_time_error_v > 0.0
+        self.dead_time_fraction > 0.0
     }
 
     /// Average pole voltages without dead time, d_x·U_dc. [V]

@@ -14,16 +14,22 @@
 pub mod accumulator;
 pub mod cylinder;
 pub mod effects;
+pub mod faults;
 pub mod friction;
 pub mod inverter;
 pub mod motor;
 pub mod plant;
 pub mod pump;
 pub mod rig;
+pub mod sensor_faults;
 pub mod sensors;
 pub mod valves;
 
 pub use effects::Effect;
-pub use plant::{Drive, EnergyBalance, InitialConditions, Inputs, Observables, Plant};
+pub use faults::PlantFaults;
+pub use plant::{
+    CurrentWatch, Drive, EnergyBalance, InitialConditions, Inputs, Observables, Plant,
+};
 pub use rig::{Rig, RigError};
+pub use sensor_faults::SensorFaults;
 pub use sensors::SensorReadings;

@@ -48,6 +48,7 @@
 use crate::accumulator::ATMOSPHERE_PA;
 use crate::accumulator::{Absorber, GasCharge};
 use crate::cylinder::Cylinder;
+use crate::faults::{DcLink, PlantFaults, PUMP_MANIFOLD_VOLUME_M3};
 use crate::friction::{Friction, Slip};
 use crate::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use crate::motor::{MagnetFlux, Motor, Phasor};
@@ -55,6 +56,9 @@ use crate::pump::Pump;
 use crate::rig::{Rig, RigError};
 use crate::sensors::{SensorReadings, Sensors};
 use crate::valves::Valve;
+
+mod faulted;
+pub use faulted::CurrentWatch;
 
 /// State indices.
 mod ix {
@@ -79,7 +83,10 @@ mod ix {
     pub const ABS_PGAS: usize = 17;
     /// Absolute gas pressure of the fill accumulator.
     pub const FILL_PGAS: usize = 18;
-    pub const N: usize = 19;
+    /// Pressure of the pump's manifold: port A's while the port is open, a node of its own
+    /// while it is blocked ([`crate::faults`]).
+    pub const PP: usize = 19;
+    pub const N: usize = 20;
 }
 
 type Vector = [f64; ix::N];
@@ -192,6 +199,11 @@ pub struct Observables {
     pub i_q_a: f64,
     /// Phase currents a, b, c. [A]
     pub i_abc_a: [f64; 3],
+    /// Currents through the bridge legs and the current sensors a, b, c: the phase
+    /// currents plus a short circuit's path current ([`crate::faults`]). [A]
+    pub i_bridge_abc_a: [f64; 3],
+    /// DC-link voltage. [V]
+    pub u_dc_v: f64,
     /// d-axis voltage applied by the inverter. [V]
     pub u_d_v: f64,
     /// q-axis voltage applied by the inverter. [V]
@@ -208,6 +220,8 @@ pub struct Observables {
     pub torque_pump_nm: f64,
     /// Port-A (high side) pressure. [Pa]
     pub p_a_pa: f64,
+    /// Pressure in the pump's manifold (port A's unless the pump's port is blocked). [Pa]
+    pub p_pump_pa: f64,
     /// Port-B (low side) pressure. [Pa]
     pub p_b_pa: f64,
     /// Pressure at the transducer (after its lag). [Pa]
@@ -346,7 +360,10 @@ pub struct Plant {
     absorber: Absorber,
     fill_gas: GasCharge,
     check: Valve,
+    /// Port B's relief valve (and port A's as built).
     relief: Valve,
+    /// Port A's relief valve as it works now (none while stuck closed).
+    relief_a: Valve,
     sensor_lag_s: f64,
     sensors: Sensors,
     max_step_s: f64,
@@ -358,6 +375,14 @@ pub struct Plant {
     last_inputs: Inputs,
     rotor: RotorPhasor,
     angle: AngleTerms,
+    /// A fault or the protection was ever switched on: the steps take the faulted path.
+    faulted: bool,
+    faults: PlantFaults,
+    dc_link: DcLink,
+    /// A short circuit's fault-path current ([`crate::faults`]). [A]
+    i_fault: f64,
+    oil_density: f64,
+    protection: faulted::Protection,
 }
 
 impl Plant {
@@ -401,6 +426,7 @@ impl Plant {
         x[ix::FILL_PGAS] = rig.fill.pressure_pa + ATMOSPHERE_PA;
         x[ix::ABS_PGAS] = absorber.gas.pressure_pa(x[ix::ABS_OIL]) + ATMOSPHERE_PA;
         x[ix::P_SENSOR] = init.p_a_pa;
+        x[ix::PP] = init.p_a_pa;
         let slip0 = |v: f64| {
             if v == 0.0 {
                 Slip::Stuck
@@ -434,6 +460,10 @@ impl Plant {
                 cracking_pa: rig.fill.relief_cracking_pa,
                 conductance_m3_s_pa: rig.fill.relief_conductance_m3_s_pa,
             },
+            relief_a: Valve {
+                cracking_pa: rig.fill.relief_cracking_pa,
+                conductance_m3_s_pa: rig.fill.relief_conductance_m3_s_pa,
+            },
             sensor_lag_s: rig.sensors.pressure.lag_time_constant_s,
             sensors: Sensors::new(&rig.sensors, rig.motor.pole_pairs, seed),
             max_step_s: rig.integration.max_step_s,
@@ -461,6 +491,12 @@ impl Plant {
                 t_cog: 0.0,
                 factor: 1.0,
             },
+            faulted: false,
+            faults: PlantFaults::default(),
+            dc_link: DcLink::new(rig.inverter.u_dc_v),
+            i_fault: 0.0,
+            oil_density: rig.oil.density_kg_m3,
+            protection: faulted::Protection::default(),
         };
         plant.angle = plant.angle_terms(init.theta_m_rad);
         plant.stored0_j = plant.stored_energy_j(&plant.x);
@@ -505,13 +541,18 @@ impl Plant {
         if dt_s.is_nan() || dt_s <= 0.0 {
             return;
         }
-        let inputs = sanitise(inputs);
+        let mut inputs = sanitise(inputs);
+        self.gate_enable(&mut inputs);
         self.last_inputs = inputs;
         let n = libm::ceil(dt_s / self.max_step_s).clamp(1.0, 1e9) as u64;
         let h = dt_s / n as f64;
-        for _ in 0..n {
-            self.impose(&inputs);
-            self.step_with_events(h, &inputs);
+        if self.faulted {
+            self.advance_faulted(n, h, inputs);
+        } else {
+            for _ in 0..n {
+                self.impose(&inputs);
+                self.step_with_events(h, &inputs);
+            }
         }
         self.t_s += dt_s;
     }
@@ -634,15 +675,15 @@ impl Plant {
 
     /// Reads every sensor at the present instant (the ADC trigger at the PWM centre).
     pub fn sample(&mut self) -> SensorReadings {
-        let e = self.angle_terms(self.x[ix::THETA]).rot_e;
-        let i_abc = dq_to_abc(self.x[ix::ID], self.x[ix::IQ], e.sin, e.cos);
+        let i_abc = self.leg_currents(self.motor_phase_currents());
         let p_sensed = if self.sensor_lag_s > 0.0 {
             self.x[ix::P_SENSOR]
         } else {
             self.x[ix::PA]
         };
+        let u_dc = self.dc_link_v();
         self.sensors
-            .sample(&i_abc, self.inverter.u_dc_v, p_sensed, self.x[ix::THETA])
+            .sample(self.t_s, &i_abc, u_dc, p_sensed, self.x[ix::THETA])
     }
 
     /// True physical quantities now, with the inputs of the last step.
@@ -650,20 +691,30 @@ impl Plant {
         let x = &self.x;
         let at = self.angle_terms(x[ix::THETA]);
         // Only the drive side of an evaluation: the hydraulic flows are not observed.
-        let el = self.electrical(x, &self.last_inputs, &at);
+        let el = if self.faulted {
+            self.electrical::<true>(x, &self.last_inputs, &at)
+        } else {
+            self.electrical::<false>(x, &self.last_inputs, &at)
+        };
+        let i_abc_a = dq_to_abc(x[ix::ID], x[ix::IQ], at.rot_e.sin, at.rot_e.cos);
         Observables {
             t_s: self.t_s,
             i_d_a: x[ix::ID],
             i_q_a: x[ix::IQ],
-            i_abc_a: dq_to_abc(x[ix::ID], x[ix::IQ], at.rot_e.sin, at.rot_e.cos),
+            i_abc_a,
+            i_bridge_abc_a: self.leg_currents(i_abc_a),
+            u_dc_v: self.dc_link_v(),
             u_d_v: el.u_d,
             u_q_v: el.u_q,
             theta_m_rad: x[ix::THETA],
             omega_m_rad_s: x[ix::OMEGA],
             torque_em_nm: self.motor.torque_nm(x[ix::ID], x[ix::IQ], &at.flux),
             torque_cogging_nm: at.t_cog,
-            torque_pump_nm: self.pump.load_torque(x[ix::PA], x[ix::PB], at.factor),
+            torque_pump_nm: self
+                .pump
+                .load_torque(self.pump_pressure(x), x[ix::PB], at.factor),
             p_a_pa: x[ix::PA],
+            p_pump_pa: self.pump_pressure(x),
             p_b_pa: x[ix::PB],
             p_sensor_pa: if self.sensor_lag_s > 0.0 {
                 x[ix::P_SENSOR]
@@ -717,6 +768,13 @@ impl Plant {
                 if enabled {
                     self.discrete.extinguished = false;
                 }
+                // A line confinement that begins now (the bridge switched off onto a short)
+                // starts from the line, not from the three-phase currents.
+                if self.faulted {
+                    if let Some(line) = self.line_mode(enabled) {
+                        self.project_line(line);
+                    }
+                }
             }
             Drive::Currents { i_d, i_q } => {
                 self.x[ix::ID] = i_d;
@@ -740,13 +798,23 @@ impl Plant {
     }
 
     fn rk4(&mut self, h: f64, inputs: &Inputs) {
+        if self.faulted {
+            self.rk4_with::<true>(h, inputs);
+        } else {
+            self.rk4_with::<false>(h, inputs);
+        }
+    }
+
+    /// [`Plant::rk4`] with the faults' terms (`FAULTED`) or without them compiled in.
+    #[inline(always)]
+    fn rk4_with<const FAULTED: bool>(&mut self, h: f64, inputs: &Inputs) {
         let x0 = self.x;
         let a0 = self.angle_terms(x0[ix::THETA]);
         let stage = |x: &Vector| {
             let a = self.angle_terms_rotated(&a0, x[ix::THETA]);
-            self.derivative_at(x, inputs, &a).0
+            self.derivative_at::<FAULTED>(x, inputs, &a).0
         };
-        let k1 = self.derivative_at(&x0, inputs, &a0).0;
+        let k1 = self.derivative_at::<FAULTED>(&x0, inputs, &a0).0;
         let k2 = stage(&axpy(&x0, 0.5 * h, &k1));
         let k3 = stage(&axpy(&x0, 0.5 * h, &k2));
         let k4 = stage(&axpy(&x0, h, &k3));
@@ -864,7 +932,16 @@ impl Plant {
         }
         // Bridge off: once the phase currents have died out through the diodes they stay
         // out while the line back-EMF cannot forward-bias the diodes.
-        if let Drive::Inverter { enabled: false, .. } = inputs.drive {
+        let line = match inputs.drive {
+            Drive::Inverter { enabled, .. } if self.faulted => self.line_mode(enabled),
+            _ => None,
+        };
+        if let Some(line) = line {
+            self.project_line(line);
+        }
+        // A short keeps the motor's circuit closed with the bridge off.
+        let closed_by_short = self.faulted && self.short_closes_circuit(line);
+        if let (Drive::Inverter { enabled: false, .. }, false) = (inputs.drive, closed_by_short) {
             let (id, iq) = (self.x[ix::ID], self.x[ix::IQ]);
             let emf = self
                 .motor
@@ -891,6 +968,19 @@ impl Plant {
         if self.sensor_lag_s <= 0.0 {
             self.x[ix::P_SENSOR] = self.x[ix::PA];
         }
+        if self.faulted && !self.faults.pump_port_blocked {
+            self.x[ix::PP] = self.x[ix::PA];
+        }
+    }
+
+    /// The pump manifold's pressure in state `x`. [Pa]
+    #[inline]
+    fn pump_pressure(&self, x: &Vector) -> f64 {
+        if self.faulted && self.faults.pump_port_blocked {
+            x[ix::PP]
+        } else {
+            x[ix::PA]
+        }
     }
 
     /// Stored energy of a state: windings, shaft and piston kinetic, slotting, spring,
@@ -908,6 +998,9 @@ impl Plant {
             + v1 * x[ix::PA] * x[ix::PA] / (2.0 * self.beta)
             + v2 * x[ix::PB] * x[ix::PB] / (2.0 * self.beta)
             + self.fill_gas.energy_j(x[ix::FILL_OIL]);
+        if self.faults.pump_port_blocked {
+            e += PUMP_MANIFOLD_VOLUME_M3 * x[ix::PP] * x[ix::PP] / (2.0 * self.beta);
+        }
         if self.absorber.enabled {
             e += self.absorber.gas.energy_j(x[ix::ABS_OIL])
                 + 0.5 * self.absorber.inertance_kg_m4 * x[ix::ABS_Q] * x[ix::ABS_Q];
@@ -918,23 +1011,40 @@ impl Plant {
     /// The right-hand side of the state equations.
     #[inline]
     fn derivative(&self, x: &Vector, inputs: &Inputs) -> (Vector, Aux) {
-        self.derivative_at(x, inputs, &self.angle_terms(x[ix::THETA]))
+        let at = self.angle_terms(x[ix::THETA]);
+        if self.faulted {
+            self.derivative_at::<true>(x, inputs, &at)
+        } else {
+            self.derivative_at::<false>(x, inputs, &at)
+        }
     }
 
     /// The inverter's d-q voltages and the current derivatives (eq. 2) driven by them; zero
     /// unless the inverter drives and the currents are alive. The phase currents are formed
     /// only when the pole voltages depend on them (dead time, free-wheeling diodes).
     #[inline]
-    fn electrical(&self, x: &Vector, inputs: &Inputs, at: &AngleTerms) -> Electrical {
+    fn electrical<const FAULTED: bool>(
+        &self,
+        x: &Vector,
+        inputs: &Inputs,
+        at: &AngleTerms,
+    ) -> Electrical {
         let Drive::Inverter { duties, enabled } = inputs.drive else {
             return Electrical::default();
         };
-        if !enabled && self.discrete.extinguished {
+        let line = if FAULTED {
+            self.line_mode(enabled)
+        } else {
+            None
+        };
+        // Died out stays out, unless a short keeps the circuit closed.
+        let shorted = FAULTED && self.short_closes_circuit(line);
+        if !enabled && self.discrete.extinguished && !shorted {
             return Electrical::default();
         }
         let (i_d, i_q) = (x[ix::ID], x[ix::IQ]);
         let (s_e, c_e) = (at.rot_e.sin, at.rot_e.cos);
-        let v_pole = if enabled && !self.inverter.has_dead_time() {
+        let v_pole = if enabled && !self.inverter.has_dead_time() && line.is_none() {
             self.inverter.pole_voltages_ideal(&duties)
         } else {
             let i_abc = dq_to_abc(i_d, i_q, s_e, c_e);
@@ -945,9 +1055,23 @@ impl Plant {
                 // at 0 V), a returning one through the upper (U_dc).
                 let u = self.inverter.u_dc_v;
                 let pole = |i: f64| if i > 0.0 { 0.0 } else { u };
-                [pole(i_abc[0]), pole(i_abc[1]), pole(i_abc[2])]
+                let mut v = [pole(i_abc[0]), pole(i_abc[1]), pole(i_abc[2])];
+                self.pin_shorted_pole(&mut v);
+                v
             }
         };
+        if let Some(line) = line {
+            let (did, diq, v_n, i) = self.line_electrical(x, line, v_pole, at.rot_e, &at.flux);
+            let n = line.idle_phase().line_direction();
+            let (c, s) = crate::faults::rotor_projections(n, at.rot_e);
+            return Electrical {
+                u_d: v_n * c,
+                u_q: v_n * s,
+                did,
+                diq,
+                p_in: 1.5 * v_n * i,
+            };
+        }
         let (u_d, u_q) = pole_to_dq(&v_pole, s_e, c_e);
         let omega_e = self.motor.pole_pairs * x[ix::OMEGA];
         let (did, diq) = self
@@ -964,7 +1088,12 @@ impl Plant {
 
     /// The right-hand side with the shaft-angle terms `at` of `x` supplied.
     #[inline]
-    fn derivative_at(&self, x: &Vector, inputs: &Inputs, at: &AngleTerms) -> (Vector, Aux) {
+    fn derivative_at<const FAULTED: bool>(
+        &self,
+        x: &Vector,
+        inputs: &Inputs,
+        at: &AngleTerms,
+    ) -> (Vector, Aux) {
         let mut dx = [0.0; ix::N];
         let mut aux = Aux::default();
         let omega = x[ix::OMEGA];
@@ -972,7 +1101,7 @@ impl Plant {
         let flux = at.flux;
 
         // --- motor and inverter (eq. 1–3, 17–19)
-        let el = self.electrical(x, inputs, at);
+        let el = self.electrical::<FAULTED>(x, inputs, at);
         dx[ix::ID] = el.did;
         dx[ix::IQ] = el.diq;
         let mut p_in = el.p_in;
@@ -982,8 +1111,10 @@ impl Plant {
 
         // --- pump (eq. 9, 20) and shaft (eq. 4)
         let (p_a, p_b) = (x[ix::PA], x[ix::PB]);
+        let blocked = FAULTED && self.faults.pump_port_blocked;
+        let p_pump = if blocked { x[ix::PP] } else { p_a };
         let factor = at.factor;
-        let t_pump = self.pump.load_torque(p_a, p_b, factor);
+        let t_pump = self.pump.load_torque(p_pump, p_b, factor);
         aux.shaft_drive =
             t_em + t_cog - t_pump - self.shaft_viscous * omega + inputs.external_torque_nm;
         let t_fric = self.shaft_friction.force(self.discrete.shaft);
@@ -1010,33 +1141,56 @@ impl Plant {
         // --- hydraulics (eq. 9–12, 22–26)
         let p_fill = x[ix::FILL_PGAS] - ATMOSPHERE_PA;
         let q_geo = self.pump.geometric_flow(omega, factor);
-        let q_int = self.pump.internal_leakage * (p_a - p_b);
-        let q_ext_a = (self.pump.external_leakage + self.pump.extra_leakage) * (p_a - p_fill);
+        // The pump's manifold (pump, its leakage, check and relief valves) is port A's node
+        // unless the pump's port is blocked ([`crate::faults`]).
+        let q_int = self.pump.internal_leakage * (p_pump - p_b);
+        let q_ext_a = (self.pump.external_leakage + self.pump.extra_leakage) * (p_pump - p_fill);
         let q_ext_b = self.pump.external_leakage * (p_b - p_fill);
         let q_cyl = self.cylinder.leakage * (p_a - p_b);
-        let q_chk_a = self.check.flow(p_fill - p_a);
+        let q_chk_a = self.check.flow(p_fill - p_pump);
         let q_chk_b = self.check.flow(p_fill - p_b);
-        let q_rel_a = self.relief.flow(p_a - p_fill);
+        let q_rel_a = self.relief_a.flow(p_pump - p_fill);
         let q_rel_b = self.relief.flow(p_b - p_fill);
+        let q_burst = if FAULTED {
+            self.burst_outflow(p_a)
+        } else {
+            0.0
+        };
         let (q_abs, abs_oil) = (x[ix::ABS_Q], x[ix::ABS_OIL]);
         let (xp, vp) = (x[ix::X], x[ix::V]);
         let (v1, v2) = self.cylinder.volumes(xp);
         let area = self.cylinder.area_m2;
-        let net_a = q_geo - q_int - q_ext_a - q_cyl + q_chk_a - q_rel_a - q_abs - area * vp;
         let net_b = -q_geo + q_int - q_ext_b + q_cyl + q_chk_b - q_rel_b + area * vp;
-        dx[ix::PA] = self.beta / v1 * net_a;
+        if blocked {
+            let net_pump = q_geo - q_int - q_ext_a + q_chk_a - q_rel_a;
+            dx[ix::PP] = self.beta / PUMP_MANIFOLD_VOLUME_M3 * net_pump;
+            dx[ix::PA] = self.beta / v1 * (-q_cyl - q_abs - area * vp - q_burst);
+        } else {
+            let net_a =
+                q_geo - q_int - q_ext_a - q_cyl + q_chk_a - q_rel_a - q_abs - area * vp - q_burst;
+            // The manifold's state follows port A's at each step's end (`project`).
+            dx[ix::PA] = self.beta / v1 * net_a;
+        }
         dx[ix::PB] = self.beta / v2 * net_b;
         dx[ix::FILL_OIL] = q_ext_a + q_ext_b + q_rel_a + q_rel_b - q_chk_a - q_chk_b;
         dx[ix::FILL_PGAS] =
             self.fill_gas
                 .pressure_rate(x[ix::FILL_PGAS], x[ix::FILL_OIL], dx[ix::FILL_OIL]);
-        let mut p_hyd = (q_int + q_cyl) * (p_a - p_b)
-            + q_ext_a * (p_a - p_fill)
+        let through = if blocked {
+            q_int * (p_pump - p_b) + q_cyl * (p_a - p_b)
+        } else {
+            (q_int + q_cyl) * (p_a - p_b)
+        };
+        let mut p_hyd = through
+            + q_ext_a * (p_pump - p_fill)
             + q_ext_b * (p_b - p_fill)
-            + q_chk_a * (p_fill - p_a)
+            + q_chk_a * (p_fill - p_pump)
             + q_chk_b * (p_fill - p_b)
-            + q_rel_a * (p_a - p_fill)
+            + q_rel_a * (p_pump - p_fill)
             + q_rel_b * (p_b - p_fill);
+        if q_burst != 0.0 {
+            p_hyd += q_burst * p_a;
+        }
         if self.absorber.enabled {
             dx[ix::ABS_OIL] = q_abs;
             let p_gas = x[ix::ABS_PGAS] - ATMOSPHERE_PA;

@@ -1,6 +1,8 @@
 //! The plant against independent numbers: analytic solutions of its sub-models, textbook
 //! formulas, the paper's equations, and conservation of energy and oil.
 
+mod common;
+use common::{quiet, speed_drive};
 use plant_model::accumulator::ATMOSPHERE_PA;
 use plant_model::motor::Motor;
 use plant_model::pump::Pump;
@@ -45,13 +47,6 @@ fn duties_for(u_d: f64, u_q: f64, theta_e: f64, u_dc: f64) -> [f64; 3] {
     let vb = -0.5 * alpha + 0.5 * SQRT3 * beta;
     let vc = -0.5 * alpha - 0.5 * SQRT3 * beta;
     [0.5 + va / u_dc, 0.5 + vb / u_dc, 0.5 + vc / u_dc]
-}
-
-fn quiet(mut rig: Rig) -> Rig {
-    rig.sensors.current.noise_a_rms = 0.0;
-    rig.sensors.pressure.noise_pa_rms = 0.0;
-    rig.sensors.dc_link.noise_v_rms = 0.0;
-    rig
 }
 
 #[test]
@@ -316,15 +311,6 @@ fn pump_flow_ripple_matches_the_kinematic_formula() {
     let pp =
         s.iter().cloned().fold(f64::MIN, f64::max) - s.iter().cloned().fold(f64::MAX, f64::min);
     assert!((pp - 0.05).abs() < 1e-4);
-}
-
-fn speed_drive(omega: f64) -> Inputs {
-    Inputs {
-        drive: Drive::ShaftSpeed { omega_rad_s: omega },
-        piston: None,
-        external_force_n: 0.0,
-        external_torque_nm: 0.0,
-    }
 }
 
 #[test]

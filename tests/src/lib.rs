@@ -6,6 +6,7 @@
 //! the design formulas, not from this code.
 
 pub mod blind;
+pub mod campaign;
 pub mod fuzz;
 
 use closed_loop::{controller_config, ClosedLoop, Sample, Scenario};

@@ -16,7 +16,7 @@
 //! applied over the defaults ([`firmware::param_store::boot`]: a corrupt, other-version
 //! or inconsistent record gives the defaults and latches fault 16; a flash without the
 //! dual-bank layout gives the defaults and fault 18), the stored torque feed-forward table
-//! loaded (a wrong size, version, CRC or amplitude refuses it alone: fault 19, the drive
+//! loaded (a wrong size, version, CRC or amplitude refuses it alone: fault 21, the drive
 //! runs uncompensated), a watchdog reset of the previous run
 //! latched as fault 11, the drive installed, the interrupt enabled, the tasks spawned. The
 //! drive starts in Disabled and measures its current offsets; a CAN `SetMode` command
@@ -152,7 +152,7 @@ fn load_parameters(
                             defmt::error!("torque feed-forward: stored table refused, {=str}", r.kind())
                         }
                     }
-                    defmt::error!("torque feed-forward: running uncompensated (fault 19)");
+                    defmt::error!("torque feed-forward: running uncompensated (fault 21)");
                     controller.report_compensation_invalid();
                 }
             }

@@ -435,6 +435,20 @@ fn arbitrary_inputs_and_commands_never_panic_and_keep_the_outputs_sane() {
         .enumerate()
     {
         let mut c = Controller::new(cfg);
+        // Powered up as on the board: offsets measured at rest, then the index passes.
+        let rest = Measurements {
+            adc_phase_current: [2048; 3],
+            adc_dc_link: 2800,
+            adc_pressure: pressure_counts(5e6),
+            ..Measurements::default()
+        };
+        for _ in 0..2000 {
+            c.on_current_sample(&rest);
+        }
+        c.on_current_sample(&Measurements {
+            encoder_index: true,
+            ..rest
+        });
         let mut rng = 0x9e37_79b9u32 ^ cfg_no as u32;
         let mut count = 0u32;
         let (mut on, mut trips) = (0u32, 0u32);
@@ -456,12 +470,15 @@ fn arbitrary_inputs_and_commands_never_panic_and_keep_the_outputs_sane() {
                     (centre as u32 + x).saturating_sub(spread) as u16
                 }
             };
+            // Plausible phase currents sum to zero, as a star's do; wild ones anything.
+            let (a, b) = (around(&mut rng, 2048, 200), around(&mut rng, 2048, 200));
+            let c_phase = if wild {
+                next(&mut rng) as u16
+            } else {
+                (3 * 2048u32).saturating_sub(a as u32 + b as u32) as u16
+            };
             let m = Measurements {
-                adc_phase_current: [
-                    around(&mut rng, 2048, 200),
-                    around(&mut rng, 2048, 200),
-                    around(&mut rng, 2048, 200),
-                ],
+                adc_phase_current: [a, b, c_phase],
                 adc_dc_link: around(&mut rng, 2800, 100),
                 adc_pressure: around(&mut rng, pressure_counts(5e6), 2000),
                 encoder_count: count,

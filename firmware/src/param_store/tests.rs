@@ -489,7 +489,7 @@ fn a_corrupt_newer_page_falls_back_to_the_older_valid_one_without_a_fault() {
 #[test]
 fn a_corrupt_feed_forward_table_is_refused_alone() {
     // One flipped bit in the table's values: the parameters still load, the table's CRC
-    // refuses it (the controller then runs uncompensated with fault 19).
+    // refuses it (the controller then runs uncompensated with fault 21).
     let mut s = store(CutFlash::blank(2 * SLOT_PAGES));
     save_with(&mut s, &table(1.0), &comp_table(4)).unwrap();
     let mut f = s.into_inner();

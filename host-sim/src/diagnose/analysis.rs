@@ -12,11 +12,12 @@
 //!    extended model, scored on the validation segment.
 //! 7. Evidence for the report: residual signatures and order spectra of the baseline.
 
+use super::angle_locked::ShaftConstants;
 use super::calibration::{
-    calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Release,
-    HYDRAULIC_WINDOW_S,
+    calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Relation,
+    Release, HYDRAULIC_WINDOW_S,
 };
-use super::candidates::{test_lines, test_relation, Extension, ShaftConstants, Tested};
+use super::candidates::{test_lines, test_relation, Extension, Tested};
 use super::cylinder::CylinderRelation;
 use super::decision::{apply_vetoes, decide, threshold, why_not};
 use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
@@ -96,12 +97,8 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         facts: &facts,
         rig,
     };
-    let mrel = MechanicalRelation {
-        log,
-        facts: &facts,
-        motion: &motion,
-        rig,
-    };
+    let orders = line_orders(rig);
+    let mrel = MechanicalRelation::new(log, &facts, &motion, rig, &orders);
     let erel = ElectricalRelation::of(log, &facts, rig);
     let crel = CylinderRelation::of(log, &facts, rig);
     // 2. Calibration, every relation in parallel.
@@ -121,7 +118,6 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         j: mv[mech::INERTIA],
         d_per_rad: mv[mech::DISPLACEMENT] / (2.0 * std::f64::consts::PI),
     };
-    let orders = line_orders(rig);
     let lines = window_lines(log, &facts, &orders, shaft.kt, shaft.j, shaft.d_per_rad);
     let (line_id, line_val): (Vec<_>, Vec<_>) = lines
         .iter()
@@ -238,6 +234,33 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             rmse_reduction_percent: 100.0 * (1.0 - ext_fit.rmse_pa / base_fit.rmse_pa),
         },
         causes,
+        calibration: [
+            ("hydraulic", Some((&hcal, hrel.specs(Release::Nothing)))),
+            ("mechanical", Some((&mcal, mrel.specs(Release::Nothing)))),
+            (
+                "electrical",
+                ecal.as_ref()
+                    .zip(erel.as_ref().map(|r| r.specs(Release::Nothing))),
+            ),
+            (
+                "cylinder",
+                ccal.as_ref()
+                    .zip(crel.as_ref().map(|r| r.specs(Release::Nothing))),
+            ),
+        ]
+        .into_iter()
+        .filter_map(|(name, c)| {
+            let (cal, specs) = c?;
+            Some((
+                name.to_string(),
+                specs
+                    .iter()
+                    .zip(&cal.fitted.values)
+                    .map(|(s, v)| (s.name.to_string(), *v))
+                    .collect(),
+            ))
+        })
+        .collect(),
         extended: Extended {
             effects: named_effect.into_iter().collect(),
             fit_percent: ext_fit.fit_percent,

@@ -23,6 +23,17 @@ use plant_model::Rig;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
 
+/// The shaft's constants the lines are read with: K_t, J, D/2π.
+#[derive(Clone, Copy, Debug)]
+pub struct ShaftConstants {
+    /// Torque constant. [N·m/A]
+    pub kt: f64,
+    /// Inertia. [kg·m²]
+    pub j: f64,
+    /// Displacement per radian. [m³/rad]
+    pub d_per_rad: f64,
+}
+
 /// Relative tolerance of the torque constant and the inertia in the torque line. [1]
 pub const TORQUE_TOLERANCE: f64 = 0.1;
 
@@ -116,12 +127,11 @@ pub fn fit_line(
     effect: LineEffect,
     lines: &[&WindowLines],
     rig: &Rig,
-    kt: f64,
-    j: f64,
-    d_per_rad: f64,
+    shaft: ShaftConstants,
     candidates: &[u32],
     coherent: bool,
 ) -> Option<LineFit> {
+    let ShaftConstants { kt, j, d_per_rad } = shaft;
     let order = effect.order(rig);
     let ripple_per_ratio = match effect {
         LineEffect::PistonRipple(z) => super::mechanical::ripple_fundamental_per_ratio(rig, z),
@@ -168,11 +178,10 @@ pub fn line_gain(
     fit: &LineFit,
     lines: &[&WindowLines],
     rig: &Rig,
-    kt: f64,
-    j: f64,
-    d_per_rad: f64,
+    shaft: ShaftConstants,
     candidates: &[u32],
 ) -> Option<f64> {
+    let ShaftConstants { kt, j, d_per_rad } = shaft;
     let order = fit.effect.order(rig);
     let ripple_per_ratio = match fit.effect {
         LineEffect::PistonRipple(z) => super::mechanical::ripple_fundamental_per_ratio(rig, z),

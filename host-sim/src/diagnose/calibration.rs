@@ -1,6 +1,7 @@
 //! Calibration before accusation: each parity relation's parameters fitted to the log
-//! within the rig's tolerance bands (Gaussian priors, [`super::least_squares`]), and the
-//! same fit with one effect's parameter released to its physically plausible range.
+//! within the rig's tolerance bands (hard bounds, every combination within them equally
+//! likely, [`super::least_squares`]), and the same fit with one effect's parameter released
+//! to its physically plausible range.
 //!
 //! The bands, as fractions of the rig file's value (or absolute where the nominal is 0):
 //!
@@ -19,9 +20,10 @@
 //! | pump displacement D | ±5 % | listed ±2 % |
 //! | saliency (reluctance torque) | 0 … 1.2 of the rig's | L_d, L_q derived from gains |
 //!
-//! The pump displacement is fixed at its rig value in the hydraulic relation: every volume
-//! there is relative to it (scaling D and all volumes together leaves p(θ) unchanged), so
-//! the volumes carry the tolerance.
+//! With the cylinder blocked every volume of the hydraulic relation is relative to the pump
+//! displacement (scaling D and all volumes together leaves p(θ) unchanged): there the
+//! fit may settle anywhere along that direction within the bands; a moving piston's A·x is
+//! an absolute volume and fixes D.
 
 use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::facts::LogFacts;
@@ -30,6 +32,7 @@ use crate::diagnose::least_squares::{
     fit, huber, variance_per_independent_sample, Fitted, ParamSpec,
 };
 use crate::diagnose::mechanical::{MechanicalParams, Mechanics, ShaftMotion};
+use nalgebra::{DMatrix, DVector};
 use plant_model::accumulator::GasCharge;
 use plant_model::Rig;
 use std::ops::Range;
@@ -92,6 +95,9 @@ pub mod hyd {
     pub const OFFSET: usize = 7;
     /// Transducer lag.
     pub const LAG: usize = 8;
+    /// Pump displacement (only the piston's volume is absolute: a blocked cylinder leaves
+    /// it to its prior).
+    pub const DISPLACEMENT: usize = 9;
 }
 
 /// Index of each mechanical parameter in the search vector.
@@ -180,6 +186,16 @@ pub fn hydraulic_specs(rig: &Rig, release: Release) -> Vec<ParamSpec> {
         ParamSpec::linear("sensor_offset_pa", n.sensor_offset_pa, 1e4, -1e6, 1e6)
             .with_band(n.sensor_offset_pa - 3e4, n.sensor_offset_pa + 3e4),
         lag,
+        ParamSpec::log(
+            "displacement_m3_per_rev",
+            n.displacement_m3_per_rev,
+            0.5,
+            2.0,
+        )
+        .with_band(
+            0.95 * n.displacement_m3_per_rev,
+            1.05 * n.displacement_m3_per_rev,
+        ),
     ]
 }
 
@@ -197,6 +213,7 @@ pub fn hydraulic_params(rig: &Rig, v: &[f64]) -> HydraulicParams {
     p.sensor_gain = v[hyd::GAIN];
     p.sensor_offset_pa = v[hyd::OFFSET];
     p.sensor_lag_s = v[hyd::LAG];
+    p.displacement_m3_per_rev = v[hyd::DISPLACEMENT];
     p
 }
 
@@ -274,24 +291,82 @@ pub fn mechanical_params(rig: &Rig, v: &[f64]) -> MechanicalParams {
     p
 }
 
-/// The mechanical relation's residuals (logged − needed q current over its noise) over
-/// `rows`.
-pub fn mechanical_residuals(
-    log: &BenchLog,
-    facts: &LogFacts,
-    motion: &ShaftMotion,
-    params: MechanicalParams,
-    rows: &[Range<usize>],
-) -> Vec<f64> {
-    let sigma = facts.noise(Signal::Iq).unwrap_or(1.0).max(1e-6);
-    let model = Mechanics::new(params);
-    let mut pred = vec![0.0; facts.rows];
-    let mut out = Vec::new();
-    for r in rows {
-        model.needed_current(log, facts, motion, r.clone(), &mut pred);
-        out.extend(r.clone().map(|k| huber((log.iq_a[k] - pred[k]) / sigma)));
+/// Rows on each side of the moving average the mechanical residual is scored through.
+pub const MECHANICAL_SMOOTHING_ROWS: usize = 5;
+
+/// The mechanical relation's residuals over `window`: logged − needed q current with the
+/// angle-locked lines projected out (`basis`, orthonormal columns over the window's rows),
+/// through a moving average of ±[`MECHANICAL_SMOOTHING_ROWS`] rows, over the averaged
+/// noise; appended to `out`.
+///
+/// The projection keeps the slow parameters blind to the lines the angle-locked effects
+/// make (a cogging torque would otherwise be half-absorbed into the inertia through the
+/// shaft's oscillation it causes). The relation is linear in its signals, so averaging the
+/// residual averages every term alike; it removes the encoder's quantisation from the
+/// acceleration (whose noise grows with frequency), which a regression would otherwise read
+/// as a smaller inertia (errors in variables).
+fn mechanical_window_residuals(
+    e: &mut [f64],
+    basis: Option<&DMatrix<f64>>,
+    sigma: f64,
+    out: &mut Vec<f64>,
+) {
+    if let Some(q) = basis {
+        if q.nrows() == e.len() {
+            let coef = q.tr_mul(&DVector::from_column_slice(e));
+            let fit = q * coef;
+            for (x, f) in e.iter_mut().zip(fit.iter()) {
+                *x -= f;
+            }
+        }
     }
-    out
+    let h = MECHANICAL_SMOOTHING_ROWS;
+    if e.len() <= 2 * h {
+        return;
+    }
+    let width = (2 * h + 1) as f64;
+    let mut sum: f64 = e[..2 * h + 1].iter().sum();
+    for k in h..e.len() - h {
+        if k > h {
+            sum += e[k + h] - e[k - h - 1];
+        }
+        out.push(huber(sum / width / sigma));
+    }
+}
+
+/// An orthonormal basis of sin/cos of k·θ over `rows` for each of `orders` below a third
+/// of the sampling rate at the window's mean speed; `None` when there is none.
+fn line_basis(
+    facts: &LogFacts,
+    t: &[f64],
+    rows: Range<usize>,
+    orders: &[u32],
+) -> Option<DMatrix<f64>> {
+    let th = &facts.theta_rad;
+    let n = rows.len();
+    let span = t[rows.end - 1] - t[rows.start];
+    if n < 4 || span <= 0.0 {
+        return None;
+    }
+    let w = ((th[rows.end - 1] - th[rows.start]) / span).abs();
+    let nyquist = 2.0 * std::f64::consts::PI / facts.period_s / 3.0;
+    let ks: Vec<f64> = orders
+        .iter()
+        .map(|k| *k as f64)
+        .filter(|k| k * w < nyquist && k * w > 0.0)
+        .collect();
+    if ks.is_empty() || 2 * ks.len() * 4 > n {
+        return None;
+    }
+    let a = DMatrix::from_fn(n, 2 * ks.len(), |i, j| {
+        let x = ks[j / 2] * th[rows.start + i];
+        if j % 2 == 0 {
+            x.cos()
+        } else {
+            x.sin()
+        }
+    });
+    Some(a.qr().q())
 }
 
 /// A parity relation the calibration fits: its search space and its residuals.
@@ -300,6 +375,16 @@ pub trait Relation: Sync {
     fn specs(&self, release: Release) -> Vec<ParamSpec>;
     /// Robust residuals (noise units, [`huber`]) at search `values` over `rows`.
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64>;
+    /// The released parameter's index and the values a coarse grid tries before the
+    /// local search (the calibrated tolerances may have bent towards a wrong basin: a
+    /// precharge far off is half-mimicked by displacement and shell volume); `None` when
+    /// the relation does not offer `release`.
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)>;
+}
+
+/// `nominal` times each of `factors`.
+pub fn scaled(nominal: f64, factors: &[f64]) -> Vec<f64> {
+    factors.iter().map(|f| nominal * f).collect()
 }
 
 /// The hydraulic relation of a log.
@@ -317,6 +402,27 @@ impl Relation for HydraulicRelation<'_> {
         hydraulic_specs(self.rig, release)
     }
 
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        let n = HydraulicParams::nominal(self.rig);
+        let p0 = n.absorber.map_or(1e6, |g| g.precharge_pa);
+        Some(match release {
+            Release::Leakage => (
+                hyd::LEAKAGE,
+                scaled(n.leakage_m3_s_pa, &[1.0, 2.0, 4.0, 8.0, 16.0]),
+            ),
+            Release::BulkModulus => (
+                hyd::BETA,
+                scaled(n.bulk_modulus_pa, &[1.0, 0.6, 0.35, 0.2, 0.1]),
+            ),
+            Release::Precharge => (
+                hyd::PRECHARGE,
+                scaled(p0, &[0.3, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0]),
+            ),
+            Release::SensorLag => (hyd::LAG, vec![0.5e-3, 3e-3, 10e-3, 30e-3, 100e-3]),
+            _ => return None,
+        })
+    }
+
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
         hydraulic_residuals(
             self.log,
@@ -328,16 +434,50 @@ impl Relation for HydraulicRelation<'_> {
     }
 }
 
+/// A window's basis of the angle lines, or `None` when it has too few rows.
+type LineBasis = Option<DMatrix<f64>>;
+
 /// The mechanical relation of a log.
 pub struct MechanicalRelation<'a> {
-    /// The log.
-    pub log: &'a BenchLog,
-    /// Its facts.
-    pub facts: &'a LogFacts,
-    /// The shaft's motion.
-    pub motion: &'a ShaftMotion,
-    /// The rig file.
-    pub rig: &'a Rig,
+    log: &'a BenchLog,
+    facts: &'a LogFacts,
+    motion: &'a ShaftMotion,
+    rig: &'a Rig,
+    orders: Vec<u32>,
+    /// The line bases of the windows seen so far, by their first and end rows.
+    bases: std::sync::Mutex<std::collections::HashMap<(usize, usize), LineBasis>>,
+}
+
+impl<'a> MechanicalRelation<'a> {
+    /// The relation, the lines at `orders` projected out of its residual.
+    pub fn new(
+        log: &'a BenchLog,
+        facts: &'a LogFacts,
+        motion: &'a ShaftMotion,
+        rig: &'a Rig,
+        orders: &[u32],
+    ) -> MechanicalRelation<'a> {
+        MechanicalRelation {
+            log,
+            facts,
+            motion,
+            rig,
+            orders: orders.to_vec(),
+            bases: Default::default(),
+        }
+    }
+
+    fn basis(&self, rows: &Range<usize>) -> Option<DMatrix<f64>> {
+        let key = (rows.start, rows.end);
+        if let Some(b) = self.bases.lock().ok()?.get(&key) {
+            return b.clone();
+        }
+        let b = line_basis(self.facts, &self.log.t_s, rows.clone(), &self.orders);
+        if let Ok(mut m) = self.bases.lock() {
+            m.insert(key, b.clone());
+        }
+        b
+    }
 }
 
 impl Relation for MechanicalRelation<'_> {
@@ -345,14 +485,23 @@ impl Relation for MechanicalRelation<'_> {
         mechanical_specs(self.rig, release)
     }
 
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        (release == Release::ShaftFriction).then(|| (mech::COULOMB, vec![0.02, 0.1, 0.3, 0.8]))
+    }
+
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
-        mechanical_residuals(
-            self.log,
-            self.facts,
-            self.motion,
-            mechanical_params(self.rig, values),
-            rows,
-        )
+        let sigma = self.facts.noise(Signal::Iq).unwrap_or(1.0).max(1e-6)
+            / ((2 * MECHANICAL_SMOOTHING_ROWS + 1) as f64).sqrt();
+        let model = Mechanics::new(mechanical_params(self.rig, values));
+        let mut pred = vec![0.0; self.facts.rows];
+        let mut out = Vec::new();
+        for r in rows {
+            model.needed_current(self.log, self.facts, self.motion, r.clone(), &mut pred);
+            let mut e: Vec<f64> = r.clone().map(|k| self.log.iq_a[k] - pred[k]).collect();
+            let basis = self.basis(r);
+            mechanical_window_residuals(&mut e, basis.as_ref(), sigma, &mut out);
+        }
+        out
     }
 }
 
@@ -427,13 +576,33 @@ pub fn test_release<R: Relation>(
     release: Release,
     base: &Calibration,
 ) -> ReleaseTest {
-    let first = fit_relation(
-        relation,
-        rows,
-        release,
-        base.scale,
-        Some(&base.fitted.values),
-    );
+    // The grid's best point along the released parameter, the others as calibrated.
+    let specs = relation.specs(release);
+    let objective_at = |v: &[f64], scale: f64| -> f64 {
+        let prior: f64 = specs
+            .iter()
+            .zip(v)
+            .filter_map(|(s, x)| s.prior.map(|(m, sd)| ((s.coordinate(*x) - m) / sd).powi(2)))
+            .sum();
+        weighed_sse(relation, v, rows, scale) + prior
+    };
+    let mut start = base.fitted.values.clone();
+    if let Some((k, grid)) = relation.released(release) {
+        let best = grid
+            .iter()
+            .map(|g| {
+                let mut v = start.clone();
+                v[k] = *g;
+                (objective_at(&v, base.scale), v)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((j, v)) = best {
+            if j < objective_at(&start, base.scale) {
+                start = v;
+            }
+        }
+    }
+    let first = fit_relation(relation, rows, release, base.scale, Some(&start));
     let scale =
         variance_per_independent_sample(&relation.residuals(&first.values, rows)).min(base.scale);
     let fitted = fit_relation(relation, rows, release, scale, Some(&first.values));

@@ -21,7 +21,7 @@
 //! the validation segment in the same units.
 
 use crate::diagnose::angle_locked::{
-    fit_line, line_gain, offset_from_line, plant_phase, LineEffect, LineFit,
+    fit_line, line_gain, offset_from_line, plant_phase, LineEffect, LineFit, ShaftConstants,
 };
 use crate::diagnose::calibration::{
     hyd, mech, test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
@@ -132,16 +132,19 @@ pub fn from_release<R: Relation>(
         Release::Nothing => (0, "none", Extension::Hydraulic(v.clone())),
     };
     let u = test.fitted.u[index];
-    let se = test.fitted.standard_error(index, 1.0);
-    // The band the calibration holds the parameter in, in search units.
-    let outside_band = match base_specs[index].prior {
-        Some((m, sd)) => {
-            let (lo, hi) = (m - 2.0 * sd, m + 2.0 * sd);
-            u - 2.0 * se > hi || u + 2.0 * se < lo
-        }
+    // Outside its band: the released estimate lies beyond it. That it lies there
+    // significantly is the likelihood ratio itself: the baseline is the best fit with the
+    // parameter held within the band (at its edge, when the data pull outwards), so Λ is
+    // the profile likelihood ratio of the band's edge against the estimate — a test that
+    // needs no covariance of the nuisance parameters, which flat bands leave singular along
+    // the directions the log does not fix.
+    let outside_band = match base_specs[index].band {
+        Some((lo, hi)) => u > hi || u < lo,
         None => false,
     };
     let value = specs[index].value(u);
+    let se = test.fitted.standard_error(index, 1.0);
+    let spread = (specs[index].value(u + se) - value).abs();
     let parameters = match test.release {
         Release::Leakage => vec![("coefficient_m3_s_pa", value - nominal_leakage(rig))],
         Release::BulkModulus => {
@@ -164,11 +167,11 @@ pub fn from_release<R: Relation>(
             - weighed_sse(relation, &test.fitted.values, validation, test.scale)
     });
     let evidence = format!(
-        "{} released from its tolerance band to {} (± {:.2} in search units, band {}): \
+        "{} released from its tolerance band to {} (± {} at one standard error, band {}): \
          Λ = {:.1} on the identification segment",
         specs[index].name,
         short(value),
-        se,
+        short(spread),
         band_text(&base_specs[index]),
         test.lambda
     );
@@ -194,12 +197,8 @@ fn short(v: f64) -> String {
 }
 
 fn band_text(s: &crate::diagnose::least_squares::ParamSpec) -> String {
-    match s.prior {
-        Some((m, sd)) => format!(
-            "{}–{}",
-            short(s.value(m - 2.0 * sd)),
-            short(s.value(m + 2.0 * sd))
-        ),
+    match s.band {
+        Some((lo, hi)) => format!("{}–{}", short(s.value(lo)), short(s.value(hi))),
         None => "none".into(),
     }
 }
@@ -222,17 +221,6 @@ pub fn test_relation<R: Relation>(
         .collect()
 }
 
-/// The shaft's constants the lines are read with: K_t, J, D/2π.
-#[derive(Clone, Copy, Debug)]
-pub struct ShaftConstants {
-    /// Torque constant. [N·m/A]
-    pub kt: f64,
-    /// Inertia. [kg·m²]
-    pub j: f64,
-    /// Displacement per radian. [m³/rad]
-    pub d_per_rad: f64,
-}
-
 /// The line effects' tests on the steady windows split at the validation segment.
 pub fn test_lines(
     identification: &[&WindowLines],
@@ -243,16 +231,15 @@ pub fn test_lines(
     cogging_orders: &[u32],
     coherent: bool,
 ) -> Vec<Tested> {
-    let ShaftConstants { kt, j, d_per_rad } = shaft;
     let mut effects = vec![LineEffect::CurrentOffset, LineEffect::FluxHarmonics];
     effects.extend(cogging_orders.iter().map(|k| LineEffect::Cogging(*k)));
     effects.extend(RIPPLE_PISTONS.iter().map(|z| LineEffect::PistonRipple(*z)));
     let mut out: Vec<Tested> = effects
         .into_iter()
         .filter_map(|e| {
-            let f = fit_line(e, identification, rig, kt, j, d_per_rad, orders, coherent)?;
-            let gain = line_gain(&f, validation, rig, kt, j, d_per_rad, orders);
-            Some(line_verdict(f, gain, rig, kt))
+            let f = fit_line(e, identification, rig, shaft, orders, coherent)?;
+            let gain = line_gain(&f, validation, rig, shaft, orders);
+            Some(line_verdict(f, gain, rig, shaft.kt))
         })
         .collect();
     if let Some(f) = fit_dead_time(identification, rig, orders) {

@@ -110,6 +110,19 @@ impl Relation for CylinderRelation<'_> {
         ]
     }
 
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        let nominal = self.rig.cylinder.coulomb_friction_n;
+        (release == Release::CylinderFriction).then(|| {
+            (
+                ix::COULOMB,
+                [0.0, 100.0, 400.0, 1500.0, 5000.0]
+                    .iter()
+                    .map(|f| nominal + f)
+                    .collect(),
+            )
+        })
+    }
+
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
         let sigma = self.facts.noise(Signal::Pressure).unwrap_or(1.0).max(1.0);
         let mut pred = vec![0.0; self.log.len()];

@@ -8,8 +8,11 @@
 //!    correlation time estimated from the log) or, for a line, by the floor of the
 //!    neighbouring orders, this is the test's false-alarm rate if the nominal model within
 //!    its tolerances were the truth.
-//! 2. **Beyond tolerance.** Its parameter lies outside its tolerance band by two standard
-//!    errors (a few percent of displacement is not entrained air).
+//! 2. **Beyond tolerance.** Its parameter's estimate lies outside its tolerance band (a
+//!    few percent of displacement is not entrained air). For a released rig parameter the
+//!    baseline of Λ is the fit held within the band, so a significant Λ with the estimate
+//!    outside says the band's edge is itself rejected; a line's amplitude must clear its
+//!    band by two standard errors.
 //! 3. **It holds on the validation segment.** The fitted extension does not make the
 //!    validation segment significantly worse (its gain there, in the same χ² units, above
 //!    −[`VALIDATION_TOLERANCE`]): an effect the validation segment excites must improve it
@@ -43,7 +46,7 @@ pub fn threshold(dof: usize) -> f64 {
 /// Why a tested effect is not named, or `None` when it qualifies.
 pub fn why_not(t: &Tested) -> Option<String> {
     let limit = threshold(t.dof);
-    if !(t.lambda > limit) {
+    if t.lambda.is_nan() || t.lambda <= limit {
         return Some(format!(
             "not significant (Λ = {:.1} below {:.1}, the χ²({}) quantile at {:.0e})",
             t.lambda, limit, t.dof, FALSE_ALARM

@@ -25,6 +25,9 @@ pub struct Diagnosis {
     pub extended: Extended,
     /// Extended minus baseline.
     pub gain: Gain,
+    /// The nominal model calibrated within its tolerance bands: per relation, each
+    /// parameter's fitted value (SI) — beyond the contract, for the engineer.
+    pub calibration: BTreeMap<String, BTreeMap<String, f64>>,
 }
 
 /// Goodness of fit of one model on the validation segment.

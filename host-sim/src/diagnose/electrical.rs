@@ -133,6 +133,10 @@ impl Relation for ElectricalRelation<'_> {
         ]
     }
 
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        (release == Release::DeadTime).then(|| (ix::DEAD_TIME, vec![0.05e-6, 0.3e-6, 1e-6, 3e-6]))
+    }
+
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
         let (Some(ud_log), Some(uq_log)) = (self.log.ud_v.as_deref(), self.log.uq_v.as_deref())
         else {

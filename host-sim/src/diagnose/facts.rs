@@ -15,22 +15,32 @@ use std::ops::Range;
 /// transducer's noise, well below the slowest stroke's travel). [m]
 pub const MOVING_PISTON_TRAVEL_M: f64 = 0.2e-3;
 
+/// Start of a log left out of the scores: a speed observer or filter settling. [s]
+pub const START_SKIP_S: f64 = 0.1;
+
 /// Shortest steady-rotation window for the angle-locked lines. [s]
-pub const STEADY_WINDOW_S: f64 = 1.0;
+pub const STEADY_WINDOW_S: f64 = 0.2;
+
+/// Length a steady window grows to before it closes (with [`STEADY_TARGET_REVOLUTIONS`]):
+/// longer windows resolve the lines better, shorter ones let a short log have any. [s]
+pub const STEADY_TARGET_S: f64 = 1.0;
+
+/// Revolutions a steady window grows to before it closes. [1]
+pub const STEADY_TARGET_REVOLUTIONS: f64 = 2.0;
 
 /// Longest steady-rotation window: at a slow holding speed it takes a few seconds to turn
 /// [`STEADY_MIN_REVOLUTIONS`]. [s]
 pub const STEADY_MAX_S: f64 = 4.0;
 
 /// Chunk whose mean speed the steady windows are built from. [s]
-pub const STEADY_CHUNK_S: f64 = 0.25;
+pub const STEADY_CHUNK_S: f64 = 0.1;
 
 /// Largest departure of a chunk's mean speed from its window's mean, relative to it. [1]
 pub const STEADY_SPREAD: f64 = 0.1;
 
 /// Fewest mechanical revolutions a steady window must hold for its lines to be resolved
-/// (order k and k ± 1 are then apart by a whole cycle per revolution). [1]
-pub const STEADY_MIN_REVOLUTIONS: f64 = 2.0;
+/// (over one revolution orders k and k ± 1 are orthogonal). [1]
+pub const STEADY_MIN_REVOLUTIONS: f64 = 1.0;
 
 /// Fraction of the largest second differences left out of the noise estimate (steps and
 /// transients, not noise). [1]
@@ -58,6 +68,8 @@ pub struct LogFacts {
     pub rows: usize,
     /// Median sampling interval. [s]
     pub period_s: f64,
+    /// Whether every interval is within 1 % of the median (uniform sampling).
+    pub uniform: bool,
     /// Shaft angle, unwrapped: the logged one or the logged speed integrated. [rad]
     pub theta_rad: Vec<f64>,
     /// Whether `theta_rad` was logged (else integrated, so its absolute phase is unknown).
@@ -66,12 +78,15 @@ pub struct LogFacts {
     pub p_low_pa: Vec<f64>,
     /// Whether the piston moves (`x_m` logged and travelling).
     pub piston_moves: bool,
-    /// First row of the validation segment (identification is `0..split`).
+    /// First row of the validation segment (identification is `start..split`).
     pub split: usize,
+    /// First row scored: the log's first [`START_SKIP_S`] hold the logger's and the
+    /// estimators' start-up, not the rig's physics.
+    pub start: usize,
     /// Noise RMS per logged signal, from the trimmed second differences. [unit]
     pub noise_rms: Vec<(Signal, f64)>,
     /// Steady-rotation windows (speed nearly constant, at least
-    /// [`STEADY_MIN_REVOLUTIONS`]), in time order.
+    /// [`STEADY_MIN_REVOLUTIONS`]), in time order, none across the segments' boundary.
     pub steady: Vec<SteadyWindow>,
 }
 
@@ -81,6 +96,9 @@ impl LogFacts {
         let rows = log.len();
         let t = &log.t_s;
         let period_s = median_period(t);
+        let uniform = t
+            .windows(2)
+            .all(|w| ((w[1] - w[0]) / period_s - 1.0).abs() < 0.01);
         let (theta_rad, angle_logged) = match log.theta_m_rad.as_deref() {
             Some(th) => (unwrap_angle(th), true),
             None => (integrated_angle(t, &log.speed_rad_s), false),
@@ -99,20 +117,36 @@ impl LogFacts {
         });
         let t_half = t[0] + 0.5 * (t[rows - 1] - t[0]);
         let split = t.partition_point(|x| *x < t_half).clamp(1, rows - 1);
+        let start = t
+            .partition_point(|x| *x < t[0] + START_SKIP_S)
+            .min(split / 4);
         let noise_rms = log
             .columns()
             .filter(|(s, _)| *s != Signal::Time)
             .map(|(s, y)| (s, noise_rms(y)))
             .collect();
-        let steady = steady_windows(t, &theta_rad, period_s);
+        let mut steady = steady_windows(&t[..split], &theta_rad[..split], period_s)
+            .into_iter()
+            .filter(|w| w.rows.start >= start)
+            .collect::<Vec<_>>();
+        steady.extend(
+            steady_windows(&t[split..], &theta_rad[split..], period_s)
+                .into_iter()
+                .map(|mut w| {
+                    w.rows = w.rows.start + split..w.rows.end + split;
+                    w
+                }),
+        );
         LogFacts {
             rows,
             period_s,
+            uniform,
             theta_rad,
             angle_logged,
             p_low_pa,
             piston_moves,
             split,
+            start,
             noise_rms,
             steady,
         }
@@ -128,7 +162,7 @@ impl LogFacts {
 
     /// Identification rows.
     pub fn identification(&self) -> Range<usize> {
-        0..self.split
+        self.start..self.split
     }
 
     /// Validation rows.
@@ -214,53 +248,59 @@ pub fn integrated_angle(t: &[f64], speed: &[f64]) -> Vec<f64> {
 }
 
 /// Steady-rotation windows: the log cut into chunks of [`STEADY_CHUNK_S`], consecutive
-/// chunks whose mean speeds stay within [`STEADY_SPREAD`] of the window's mean joined until
-/// the window holds at least [`STEADY_WINDOW_S`] and [`STEADY_MIN_REVOLUTIONS`] (at most
-/// [`STEADY_MAX_S`]); a window that cannot reach that is dropped.
+/// chunks whose mean speeds stay within [`STEADY_SPREAD`] of the window's mean joined. A
+/// window closes once it holds [`STEADY_TARGET_REVOLUTIONS`] and [`STEADY_TARGET_S`] (or
+/// [`STEADY_MAX_S`]); one cut short by a change of speed or the segment's end is kept if
+/// it holds at least [`STEADY_MIN_REVOLUTIONS`] and [`STEADY_WINDOW_S`].
 fn steady_windows(t: &[f64], theta: &[f64], period_s: f64) -> Vec<SteadyWindow> {
     let n = t.len().min(theta.len());
     let chunk = ((STEADY_CHUNK_S / period_s).round() as usize).max(8);
     let speed =
         |r: &Range<usize>| (theta[r.end - 1] - theta[r.start]) / (t[r.end - 1] - t[r.start]);
+    let turned = |r: &Range<usize>| (theta[r.end - 1] - theta[r.start]).abs() / (2.0 * PI);
+    let length = |r: &Range<usize>| t[r.end - 1] - t[r.start];
     let mut out = Vec::new();
+    let keep = |rows: Range<usize>, out: &mut Vec<SteadyWindow>| {
+        if turned(&rows) >= STEADY_MIN_REVOLUTIONS && length(&rows) >= STEADY_WINDOW_S {
+            out.push(SteadyWindow {
+                speed_rad_s: speed(&rows),
+                revolutions: turned(&rows),
+                rows,
+            });
+        }
+    };
+    // The open window: its first row and its chunks' mean speeds.
     let mut open: Option<(usize, Vec<f64>)> = None;
     let mut start = 0;
     while start + chunk <= n {
         let c = start..start + chunk;
         let w = speed(&c);
-        let joined = match open.take() {
-            Some((s0, mut speeds)) => {
-                let mean = speeds.iter().sum::<f64>() / speeds.len() as f64;
-                if w != 0.0
-                    && (w - mean).abs() <= STEADY_SPREAD * mean.abs()
-                    && w.signum() == mean.signum()
-                {
-                    speeds.push(w);
-                    Some((s0, speeds))
-                } else {
-                    None
-                }
-            }
-            None => None,
-        };
-        let (s0, speeds) = joined.unwrap_or((c.start, vec![w]));
-        let rows = s0..c.end;
-        let turned = (theta[rows.end - 1] - theta[rows.start]).abs() / (2.0 * PI);
-        let length = t[rows.end - 1] - t[rows.start];
-        if w != 0.0 && turned >= STEADY_MIN_REVOLUTIONS && length >= STEADY_WINDOW_S
-            || length >= STEADY_MAX_S
-        {
-            if turned >= STEADY_MIN_REVOLUTIONS && w != 0.0 {
-                out.push(SteadyWindow {
-                    speed_rad_s: speed(&rows),
-                    rows,
-                    revolutions: turned,
-                });
-            }
-        } else {
-            open = Some((s0, speeds));
-        }
         start += chunk;
+        if let Some((s0, mut speeds)) = open.take() {
+            let mean = speeds.iter().sum::<f64>() / speeds.len() as f64;
+            if w != 0.0
+                && (w - mean).abs() <= STEADY_SPREAD * mean.abs()
+                && w.signum() == mean.signum()
+            {
+                speeds.push(w);
+                let rows = s0..c.end;
+                if (turned(&rows) >= STEADY_TARGET_REVOLUTIONS && length(&rows) >= STEADY_TARGET_S)
+                    || length(&rows) >= STEADY_MAX_S
+                {
+                    keep(rows, &mut out);
+                } else {
+                    open = Some((s0, speeds));
+                }
+                continue;
+            }
+            keep(s0..c.start, &mut out);
+        }
+        if w != 0.0 {
+            open = Some((c.start, vec![w]));
+        }
+    }
+    if let Some((s0, _)) = open {
+        keep(s0..(start).min(n), &mut out);
     }
     out
 }

@@ -45,6 +45,9 @@ pub struct ParamSpec {
     pub u_bounds: (f64, f64),
     /// Gaussian prior on u as (mean, standard deviation), or none (flat within bounds).
     pub prior: Option<(f64, f64)>,
+    /// The tolerance band on u the bounds were narrowed to ([`ParamSpec::with_band`]), if
+    /// any: the parameter's released fit is judged against it.
+    pub band: Option<(f64, f64)>,
     /// Start of the search in u.
     pub start: f64,
 }
@@ -74,6 +77,7 @@ impl ParamSpec {
             scale: Scale::Log,
             u_bounds: (lo.ln(), hi.ln()),
             prior: None,
+            band: None,
             start: 0.0,
         }
     }
@@ -86,15 +90,26 @@ impl ParamSpec {
             scale: Scale::Linear { unit },
             u_bounds: ((lo - nominal) / unit, (hi - nominal) / unit),
             prior: None,
+            band: None,
             start: 0.0,
         }
     }
 
-    /// With a tolerance band `[lo, hi]` (values) as a Gaussian prior: its mean the band's
-    /// middle in u, two standard deviations its half-width.
+    /// Held within a tolerance band `[lo, hi]` (values): the bounds narrowed to it, flat
+    /// within (every tolerance combination equally likely a priori), the start inside it.
     pub fn with_band(mut self, lo: f64, hi: f64) -> ParamSpec {
         let (a, b) = (self.coordinate(lo), self.coordinate(hi));
-        self.prior = Some((0.5 * (a + b), 0.25 * (b - a).abs().max(1e-9)));
+        let (a, b) = (a.min(b), a.max(b));
+        let (lo_u, hi_u) = self.u_bounds;
+        self.u_bounds = (a.max(lo_u), b.min(hi_u).max(a.max(lo_u)));
+        self.band = Some((a, b));
+        self.start = self.start.clamp(self.u_bounds.0, self.u_bounds.1);
+        self
+    }
+
+    /// With a Gaussian prior on u of mean `mean` and standard deviation `sd`.
+    pub fn with_prior(mut self, mean: f64, sd: f64) -> ParamSpec {
+        self.prior = Some((mean, sd.max(1e-12)));
         self
     }
 
@@ -293,7 +308,16 @@ const PATIENCE: usize = 25;
 
 /// Fits `specs` to `model` from their starts.
 pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
-    let v0 = DVector::from_iterator(specs.len(), specs.iter().map(|s| s.v_of_u(s.start)));
+    // A start on a bound would freeze the search there (the sine transform is flat at its
+    // ends): every start at least 1 % of the range inside.
+    let v0 = DVector::from_iterator(
+        specs.len(),
+        specs.iter().map(|s| {
+            let (lo, hi) = s.u_bounds;
+            let margin = 0.01 * (hi - lo);
+            s.v_of_u(s.start.clamp(lo + margin, hi - margin))
+        }),
+    );
     let problem = Problem {
         model,
         specs,
@@ -339,7 +363,9 @@ pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
 }
 
 /// (JᵀJ)⁻¹ in u at `u` (data and prior rows), by central differences kept inside the
-/// bounds.
+/// bounds, over the parameters off their bounds: one held at a bound by the data is
+/// fixed there (the reduced Hessian of a bound-constrained problem), its row and column
+/// zero.
 fn covariance<M: Model>(
     model: &M,
     specs: &[ParamSpec],
@@ -347,12 +373,19 @@ fn covariance<M: Model>(
     r0: &[f64],
 ) -> Option<DMatrix<f64>> {
     let n = specs.len();
-    if n == 0 {
-        return None;
+    let free: Vec<usize> = (0..n)
+        .filter(|&k| {
+            let (lo, hi) = specs[k].u_bounds;
+            let margin = 0.01 * (hi - lo);
+            u[k] > lo + margin && u[k] < hi - margin
+        })
+        .collect();
+    if free.is_empty() {
+        return Some(DMatrix::zeros(n, n));
     }
-    let columns: Vec<Vec<f64>> = (0..n)
-        .into_par_iter()
-        .map(|k| {
+    let columns: Vec<Vec<f64>> = free
+        .par_iter()
+        .map(|&k| {
             let (lo, hi) = specs[k].u_bounds;
             let h = 1e-3 * (1.0 + u[k].abs());
             let (a, b) = ((u[k] - h).max(lo), (u[k] + h).min(hi));
@@ -380,15 +413,23 @@ fn covariance<M: Model>(
         })
         .collect();
     let m = r0.len();
-    let mut jtj = DMatrix::from_fn(n, n, |i, j| {
+    let f = free.len();
+    let mut jtj = DMatrix::from_fn(f, f, |i, j| {
         (0..m).map(|r| columns[i][r] * columns[j][r]).sum::<f64>()
     });
-    for (k, s) in specs.iter().enumerate() {
-        if let Some((_, sd)) = s.prior {
-            jtj[(k, k)] += 1.0 / (sd * sd);
+    for (i, &k) in free.iter().enumerate() {
+        if let Some((_, sd)) = specs[k].prior {
+            jtj[(i, i)] += 1.0 / (sd * sd);
         }
     }
-    jtj.try_inverse()
+    let inv = jtj.try_inverse()?;
+    let mut full = DMatrix::zeros(n, n);
+    for (i, &a) in free.iter().enumerate() {
+        for (j, &b) in free.iter().enumerate() {
+            full[(a, b)] = inv[(i, j)];
+        }
+    }
+    Some(full)
 }
 
 #[cfg(test)]
@@ -425,19 +466,35 @@ mod tests {
     }
 
     #[test]
-    fn a_band_prior_holds_a_parameter_the_data_do_not_fix() {
-        // The model does not depend on the second parameter: its prior keeps it at the
-        // band's middle, and its error bar is the prior's (a quarter of the band in u).
+    fn a_prior_holds_a_parameter_the_data_do_not_fix() {
+        // The model does not depend on the second parameter: its prior keeps it at its mean,
+        // and its error bar is the prior's.
         let model = |v: &[f64]| vec![(v[0] - 3.0) / 0.1];
         let specs = [
             ParamSpec::linear("x", 0.0, 1.0, -10.0, 10.0),
-            ParamSpec::log("free", 1.0, 0.5, 2.0).with_band(0.9, 1.1),
+            ParamSpec::log("free", 1.0, 0.5, 2.0).with_prior(0.05, 0.02),
         ];
         let f = fit(&model, &specs);
         assert!((f.values[0] - 3.0).abs() < 1e-6);
-        assert!((f.values[1] - 1.0).abs() < 0.01, "{}", f.values[1]);
-        let band = (1.1f64 / 0.9).ln();
-        assert!((f.standard_error(1, 1.0) - 0.25 * band).abs() < 1e-3 * band);
+        assert!(
+            (f.values[1] - 0.05f64.exp()).abs() < 1e-3,
+            "{}",
+            f.values[1]
+        );
+        assert!((f.standard_error(1, 1.0) - 0.02).abs() < 1e-4);
+    }
+
+    #[test]
+    fn a_band_holds_a_parameter_the_data_pull_out_of_it() {
+        // The data want 3; the band is 0.9–1.1: the fit stops at its edge, whatever the start.
+        let model = |v: &[f64]| vec![(v[0] - 3.0) / 0.1];
+        let spec = ParamSpec::log("x", 1.0, 0.1, 10.0).with_band(0.9, 1.1);
+        let f = fit(&model, &[spec]);
+        assert!(
+            f.values[0] <= 1.1 + 1e-9 && f.values[0] > 1.09,
+            "{}",
+            f.values[0]
+        );
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //!   [`electrical`] (voltages, when logged), [`cylinder`] (pressure from the piston's
 //!   force balance, when it moves).
 //! - [`least_squares`] and [`calibration`]: the nominal model fitted to the log within the
-//!   rig's tolerance bands (Gaussian priors), and with one effect's parameter released.
+//!   rig's tolerance bands, and with one effect's parameter released.
 //! - [`lines`], [`angle_locked`], [`dead_time`]: the angle-locked lines of the steady
 //!   windows and the effects that make them.
 //! - [`candidates`], [`decision`]: every effect tested, and the one the log convicts.
