@@ -285,6 +285,23 @@ pub enum Function {
 }
 
 impl Function {
+    /// Every command, in identifier order.
+    pub const ALL: [Function; 13] = [
+        Function::SetMode,
+        Function::SetPressure,
+        Function::SetSpeed,
+        Function::ClearFaults,
+        Function::Heartbeat,
+        Function::SetParameter,
+        Function::GetParameter,
+        Function::SaveParameters,
+        Function::StepTest,
+        Function::Commission,
+        Function::CompensationBin,
+        Function::CompensationCommit,
+        Function::CompensationSweep,
+    ];
+
     /// Identifier base of the command.
     pub fn id_base(self) -> u16 {
         match self {
@@ -545,6 +562,19 @@ pub enum RejectReason {
 }
 
 impl RejectReason {
+    /// Every reason, in code order.
+    pub const ALL: [RejectReason; 9] = [
+        RejectReason::BelowMinimum,
+        RejectReason::AboveMaximum,
+        RejectReason::WrongLength,
+        RejectReason::UnknownMode,
+        RejectReason::NotAllowed,
+        RejectReason::UnknownFunction,
+        RejectReason::Invalid,
+        RejectReason::UnknownCode,
+        RejectReason::NotReady,
+    ];
+
     /// The wire code.
     pub fn code(self) -> u8 {
         match self {

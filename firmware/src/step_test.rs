@@ -31,6 +31,9 @@ pub enum StepLoop {
 }
 
 impl StepLoop {
+    /// Every loop, in code order.
+    pub const ALL: [StepLoop; 3] = [StepLoop::Current, StepLoop::Speed, StepLoop::Pressure];
+
     /// Wire code.
     pub fn code(self) -> u8 {
         self as u8

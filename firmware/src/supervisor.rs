@@ -40,14 +40,26 @@ impl Mode {
         self as u8
     }
 
+    /// Every mode, in code order.
+    pub const ALL: [Mode; 4] = [
+        Mode::Disabled,
+        Mode::Calibrating,
+        Mode::Speed,
+        Mode::Pressure,
+    ];
+
     /// From the wire/telemetry code.
     pub fn from_code(code: u8) -> Option<Mode> {
-        match code {
-            0 => Some(Mode::Disabled),
-            1 => Some(Mode::Calibrating),
-            2 => Some(Mode::Speed),
-            3 => Some(Mode::Pressure),
-            _ => None,
+        Mode::ALL.into_iter().find(|m| m.code() == code)
+    }
+
+    /// The mode's name as tools show it (`disabled`, `calibrating`, `speed`, `pressure`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Disabled => "disabled",
+            Mode::Calibrating => "calibrating",
+            Mode::Speed => "speed",
+            Mode::Pressure => "pressure",
         }
     }
 
@@ -184,9 +196,10 @@ impl FaultCode {
     }
 }
 
-impl fmt::Display for FaultCode {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = match self {
+impl FaultCode {
+    /// What the fault means, in a few words (`phase over-current`).
+    pub fn description(self) -> &'static str {
+        match self {
             FaultCode::PhaseOverCurrent => "phase over-current",
             FaultCode::DcLinkOverVoltage => "DC-link over-voltage",
             FaultCode::DcLinkUnderVoltage => "DC-link under-voltage",
@@ -218,8 +231,13 @@ impl fmt::Display for FaultCode {
             FaultCode::CompensationTableInvalid => {
                 "stored torque feed-forward table refused, running uncompensated"
             }
-        };
-        write!(f, "fault {}: {}", self.code(), s)
+        }
+    }
+}
+
+impl fmt::Display for FaultCode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "fault {}: {}", self.code(), self.description())
     }
 }
 

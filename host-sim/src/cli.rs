@@ -19,6 +19,7 @@ use crate::simulate::SimulateArgs;
 use crate::study::precharge_sweep::SweepPrechargeArgs;
 use crate::study::AccumulatorDesignArgs;
 use crate::tune::TuneArgs;
+use crate::watch::WatchArgs;
 use clap::{Parser, Subcommand};
 use plant_model::Rig;
 use std::io::{self, Write};
@@ -57,6 +58,8 @@ pub enum Command {
     Tune(TuneArgs),
     /// Turn defmt telemetry (as printed by the host decoder) into a bench log.
     Ingest(IngestArgs),
+    /// Live view of the drive's telemetry (traces, mode, fault, pulsation); --out logs it.
+    Watch(WatchArgs),
     /// Say what the simulation gets wrong on a bench log, and why.
     Diagnose(DiagnoseArgs),
     /// Learn the angle-indexed torque feed-forward from bench logs: table, CAN frames,
@@ -102,6 +105,7 @@ impl Command {
             Command::Commission(a) => a.paths(),
             Command::Tune(a) => a.paths(),
             Command::Ingest(a) => a.paths(),
+            Command::Watch(a) => a.paths(),
             Command::Diagnose(a) => a.paths(),
             Command::Compensate(a) => a.paths(),
         }
@@ -125,6 +129,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Commission(a) => crate::commission::run_commission(&rig, a),
         Command::Tune(a) => crate::tune::run_tune(&rig, a),
         Command::Ingest(a) => crate::ingest::run_ingest(a),
+        Command::Watch(a) => crate::watch::run_watch(&rig, a),
         Command::Diagnose(a) => crate::diagnose::command::run_diagnose(&rig, a),
         Command::Compensate(a) => crate::compensate::run_compensate(&rig, a),
     }

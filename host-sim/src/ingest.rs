@@ -231,7 +231,7 @@ fn out_of_range_field(f: &TelemetryFrame) -> Option<(&'static str, f64)> {
 }
 
 /// A frame's values in [`COLUMNS`] order (the bench-log column names). [SI]
-fn frame_values(f: &TelemetryFrame) -> [f64; 12] {
+pub fn frame_values(f: &TelemetryFrame) -> [f64; 12] {
     [
         f.t_s,
         f.p_ref_pa as f64,
@@ -248,13 +248,60 @@ fn frame_values(f: &TelemetryFrame) -> [f64; 12] {
     ]
 }
 
+/// What one line of a decoder's output holds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Line {
+    /// A telemetry frame fit for a bench log.
+    Frame(TelemetryFrame),
+    /// No telemetry tag: another log line, a location line, a blank line.
+    Other,
+    /// A telemetry line that does not parse or breaks the bench-log rules.
+    Malformed(LineProblem),
+}
+
+/// Classifies a decoder's output line by line: the firmware's [`parse_line`], then the
+/// bench log's rules (finite values, physical ranges, time increasing from frame to frame).
+/// `eha ingest` and `eha watch` read telemetry through it.
+#[derive(Clone, Debug, Default)]
+pub struct LineReader {
+    /// The last accepted frame's time. [s]
+    last_t: Option<f64>,
+}
+
+impl LineReader {
+    /// What `text` (one line, its line break removed or not) holds; an accepted frame's
+    /// time becomes the one the next must exceed.
+    pub fn classify(&mut self, text: &str) -> Line {
+        let text = text.trim_end_matches(['\n', '\r']);
+        let frame = match parse_line(text) {
+            Ok(f) => f,
+            Err(ParseError::NoTag) => return Line::Other,
+            Err(e) => return Line::Malformed(LineProblem::Parse(e)),
+        };
+        if let Some(k) = non_finite_field(&frame) {
+            return Line::Malformed(LineProblem::NotFinite(k));
+        }
+        if let Some((k, v)) = out_of_range_field(&frame) {
+            return Line::Malformed(LineProblem::OutOfRange(k, v));
+        }
+        if let Some(previous) = self.last_t.filter(|p| frame.t_s <= *p) {
+            return Line::Malformed(LineProblem::TimeNotIncreasing {
+                previous,
+                value: frame.t_s,
+            });
+        }
+        self.last_t = Some(frame.t_s);
+        Line::Frame(frame)
+    }
+}
+
 /// Reads a decoder's output from `input` (`file` names it in messages). Returns the log
 /// and the counts whatever they are; [`check`] decides whether the result is usable.
 pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), IngestError> {
     let mut out = Ingested::default();
     let mut buf = Vec::new();
     let mut line_no = 0usize;
-    let mut last_t: Option<f64> = None;
+    let mut reader = LineReader::default();
     loop {
         buf.clear();
         let n =
@@ -276,43 +323,22 @@ pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), 
         line_no += 1;
         // A decoder's output may carry bytes that are not UTF-8 on lines that are not
         // telemetry; telemetry itself is ASCII, so a lossy view loses nothing of it.
-        let text = String::from_utf8_lossy(&buf);
-        let text = text.trim_end_matches(['\n', '\r']);
-        let frame = match parse_line(text) {
-            Ok(f) => f,
-            Err(ParseError::NoTag) => {
+        let frame = match reader.classify(&String::from_utf8_lossy(&buf)) {
+            Line::Frame(f) => f,
+            Line::Other => {
                 out.skipped += 1;
                 continue;
             }
-            Err(e) => {
-                out.note(line_no, LineProblem::Parse(e));
+            Line::Malformed(problem) => {
+                out.note(line_no, problem);
                 continue;
             }
         };
-        if let Some(k) = non_finite_field(&frame) {
-            out.note(line_no, LineProblem::NotFinite(k));
-            continue;
-        }
-        if let Some((k, v)) = out_of_range_field(&frame) {
-            out.note(line_no, LineProblem::OutOfRange(k, v));
-            continue;
-        }
-        if let Some(previous) = last_t.filter(|p| frame.t_s <= *p) {
-            out.note(
-                line_no,
-                LineProblem::TimeNotIncreasing {
-                    previous,
-                    value: frame.t_s,
-                },
-            );
-            continue;
-        }
         if out.frames() == MAX_ROWS {
             return Err(IngestError::TooManyFrames {
                 file: file.to_path_buf(),
             });
         }
-        last_t = Some(frame.t_s);
         if frame.fault.is_some() {
             out.faulted_frames += 1;
         }

@@ -12,10 +12,12 @@
 //!   log.
 //! - [`ingest`]: the firmware's defmt telemetry (decoded text) to a bench log.
 //! - [`commission`], [`tune`]: commissioning on the simulated motor and loop tuning from a
-//!   step log.
+//!   step log; [`can_commands`]: parameter changes as `cansend` lines and `candump` logs.
 //! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain.
+//! - [`watch`]: the drive's telemetry live in the terminal, and the bench log as it comes.
 
 pub mod bench_log;
+pub mod can_commands;
 pub mod cli;
 pub mod commission;
 pub mod compensate;
@@ -30,3 +32,4 @@ pub mod simulate;
 pub mod study;
 pub mod tune;
 pub mod values;
+pub mod watch;

@@ -65,6 +65,9 @@ pub struct TuneArgs {
     /// Write the results as JSON (`-`: standard output).
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+    /// Also write the CAN commands as a `candump -l` log (`canplayer -I FILE` replays it).
+    #[arg(long, value_name = "FILE")]
+    pub can_log: Option<PathBuf>,
 }
 
 impl TuneArgs {
@@ -73,6 +76,7 @@ impl TuneArgs {
         Declared::default()
             .input("LOG", Some(&self.log))
             .file("--json", self.json.as_ref())
+            .file("--can-log", self.can_log.as_ref())
     }
 }
 
@@ -504,7 +508,11 @@ pub fn run_tune(rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
     let t = tune(rig, &log, args.loop_kind, target);
     busy.finish_and_clear();
     let t = t?;
-    let commands = can::command_lines(&t.settings).map_err(CliError::Failed)?;
+    let frames = can::parameter_commands(&t.settings).map_err(CliError::Failed)?;
+    let commands = crate::can_commands::cansend_lines(&frames);
+    if let Some(path) = &args.can_log {
+        crate::can_commands::write_candump_log(path, &frames)?;
+    }
     if let Some(path) = &args.json {
         write_json(path, &t.to_json(&commands))?;
         if is_stdout(path) {

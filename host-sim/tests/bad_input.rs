@@ -49,13 +49,18 @@ fn refused(args: &[&str], named: &[&str]) -> String {
 
 /// A valid bench log of a pressure hold (simulated, 2 kHz, 1 s).
 fn hold_log(dir: &Path) -> PathBuf {
-    let log = dir.join("hold.csv");
+    hold_log_of(dir, "hold.csv", "1")
+}
+
+/// A pressure-hold log of `seconds` written to `dir/name`.
+fn hold_log_of(dir: &Path, name: &str, seconds: &str) -> PathBuf {
+    let log = dir.join(name);
     let o = eha(&[
         "simulate",
         "--scenario",
         "pressure-hold",
         "--duration",
-        "1",
+        seconds,
         "--out",
         s(&log),
     ]);
@@ -111,8 +116,25 @@ fn bad_paths_are_refused_before_the_run_and_leave_nothing() {
         .status()
         .unwrap()
         .success());
+    // Output folders holding a special file where the command would write one of its own.
+    let demo_out = dir.join("demo-out");
+    fs::create_dir(&demo_out).unwrap();
+    assert!(std::process::Command::new("mkfifo")
+        .arg(demo_out.join("speed_step.svg"))
+        .status()
+        .unwrap()
+        .success());
+    std::os::unix::fs::symlink("/dev/null", demo_out.join("sweep.svg")).unwrap();
     let before = entries(&dir);
     let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
+        (
+            vec!["demo", "--out", s(&demo_out)],
+            vec!["speed_step.svg", "FIFO"],
+        ),
+        (
+            vec!["sweep-precharge", "--values", "5e6", "--out", s(&demo_out)],
+            vec!["sweep.svg", "character device"],
+        ),
         // Inputs: missing, a folder, a device.
         (
             vec!["diagnose", s(&missing)],
@@ -635,7 +657,8 @@ fn garbled_files_get_short_readable_messages() {
 #[test]
 fn an_interrupted_run_leaves_nothing_behind() {
     let dir = scratch("interrupt");
-    let log = hold_log(&dir);
+    // Long enough that the diagnosis is still running when the signal arrives.
+    let log = hold_log_of(&dir, "hold.csv", "20");
     let report = dir.join("report");
     let json = dir.join("d.json");
     let before = entries(&dir);

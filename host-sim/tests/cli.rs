@@ -222,8 +222,36 @@ fn help_and_version_succeed() {
         "tune",
         "ingest",
         "diagnose",
+        "watch",
     ] {
         assert!(help.contains(c), "{c} missing from --help");
+    }
+}
+
+#[test]
+fn demo_writes_a_png_beside_every_svg_and_the_pressure_figure_apart_from_the_reading() {
+    let dir = scratch("demo-figures");
+    let o = eha(&["demo", "--out", s(&dir)]);
+    assert_eq!(status(&o), 0, "{}", stderr(&o));
+    let mut svgs = 0;
+    for e in fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "svg") {
+            svgs += 1;
+            let png = fs::read(p.with_extension("png")).expect("a PNG beside the SVG");
+            assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{}", p.display());
+        }
+    }
+    assert_eq!(svgs, 4);
+    // The true pressures on one scale, the transducer's reading on a panel of its own.
+    let svg = fs::read_to_string(dir.join("pressure_trace.svg")).unwrap();
+    for label in [
+        "true p - 5 MPa [kPa]",
+        "measured p - 5 MPa [kPa]",
+        "true, no absorber",
+        "true, absorber fitted",
+    ] {
+        assert!(svg.contains(label), "{label}");
     }
 }
 

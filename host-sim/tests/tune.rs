@@ -239,4 +239,31 @@ fn json_has_the_contracts_fields_and_the_can_commands_set_the_precharge() {
             .any(|c| c.starts_with("can0 201#22") && c.contains("absorber_precharge_pa")),
         "{cmds:?}"
     );
+    // The same frames as a `candump -l` log for canplayer: `(seconds.micro) can0 ID#DATA`,
+    // in the order of the cansend lines, timestamps increasing.
+    let can_log = log.with_file_name("tune.candump");
+    let o = eha(&[
+        "tune",
+        s(&log),
+        "--loop",
+        "pressure",
+        "--can-log",
+        s(&can_log),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = fs::read_to_string(&can_log).unwrap();
+    let mut last = 0.0;
+    let mut frames = Vec::new();
+    for line in text.lines() {
+        let (stamp, frame) = line.split_once(") can0 ").expect("candump -l layout");
+        let t: f64 = stamp.trim_start_matches('(').parse().unwrap();
+        assert!(t > last, "{text}");
+        last = t;
+        frames.push(frame);
+    }
+    let sent: Vec<&str> = cmds
+        .iter()
+        .map(|c| c.split_whitespace().nth(1).unwrap())
+        .collect();
+    assert_eq!(frames, sent);
 }

@@ -22,8 +22,8 @@ fn an_open_phase_leaves_one_rl_line_between_the_other_two() {
     // torque. b and c driven 2δ·U_dc apart: v_n = 2δ·U_dc/√3,
     // i(t) = v_n/R_s·(1 − e^{−t·R_s/L_d}), i_b = −i_c = (√3/2)·i, i_a = 0.
     let mut rig = quiet(Rig::nominal());
-    rig.shaft.static_nm = 1e4;
-    rig.shaft.coulomb_nm = 1e4;
+    rig.shaft.static_nm = 1e3;
+    rig.shaft.coulomb_nm = 1e3;
     let init = InitialConditions {
         theta_m_rad: PI / 8.0,
         ..InitialConditions::at_rest(&rig)
@@ -445,8 +445,8 @@ fn transducer_and_current_channel_faults_read_like_the_adc() {
     assert_eq!(drifted, (zero + (p_now + 0.1e6) / lsb).round() as u16);
     // Current channel b: gain 1.5, then clipped at 2 A, then stuck (rotor held).
     let mut rig = rig;
-    rig.shaft.static_nm = 1e4;
-    rig.shaft.coulomb_nm = 1e4;
+    rig.shaft.static_nm = 1e3;
+    rig.shaft.coulomb_nm = 1e3;
     let mut plant = Plant::new(&rig, &InitialConditions::at_rest(&rig), 1).unwrap();
     for _ in 0..300 {
         plant.advance(50e-6, &Inputs::duties([0.5, 0.52, 0.48], true));

@@ -52,9 +52,10 @@ fn duties_for(u_d: f64, u_q: f64, theta_e: f64, u_dc: f64) -> [f64; 3] {
 #[test]
 fn locked_rotor_current_steps_rise_with_l_over_r() {
     let mut rig = quiet(Rig::nominal());
-    // A rotor held by a brake: breakaway far above any torque here.
-    rig.shaft.static_nm = 1e4;
-    rig.shaft.coulomb_nm = 1e4;
+    // A rotor held by a brake: breakaway (the largest a rig may have) far above any torque
+    // here.
+    rig.shaft.static_nm = 1e3;
+    rig.shaft.coulomb_nm = 1e3;
     let (r, u_dc) = (rig.motor.r_s_ohm, rig.inverter.u_dc_v);
     for (axis, l) in [("d", rig.motor.l_d_h), ("q", rig.motor.l_q_h)] {
         let mut plant = Plant::new(&rig, &InitialConditions::at_rest(&rig), 1).unwrap();
@@ -102,7 +103,7 @@ fn back_emf_at_constant_speed_is_psi_f_times_omega_e() {
     // A flywheel so heavy that the speed is constant: applying exactly u_q = ψ_f·ω_e, u_d = 0
     // keeps the currents at zero; 5 % less makes them flow.
     let mut rig = quiet(Rig::nominal());
-    rig.shaft.motor_inertia_kg_m2 = 1e6;
+    rig.shaft.motor_inertia_kg_m2 = 10.0; // the largest a rig may have
     rig.cylinder.blocked = true;
     let omega_m = 100.0;
     let omega_e = 4.0 * omega_m;

@@ -68,13 +68,13 @@ fn measurement() -> impl Strategy<Value = Measurements> {
         any::<bool>(),
         any::<u32>(),
     )
-        .prop_map(|(i, udc, p, enc, idx, cap)| Measurements {
+        .prop_map(|(i, udc, p, enc, idx, idx_count)| Measurements {
             adc_phase_current: i,
             adc_dc_link: udc,
             adc_pressure: p,
             encoder_count: enc,
             encoder_index: idx,
-            encoder_index_count: cap,
+            encoder_index_count: idx_count,
         })
 }
 

@@ -34,9 +34,10 @@ struct Response {
 
 fn q_step(pwm_hz: f64, seed: u64) -> Response {
     let mut rig = Rig::nominal();
-    // Rotor locked: a breakaway torque 1000× the motor's torque at 10 A.
-    rig.shaft.static_nm = 1e4;
-    rig.shaft.coulomb_nm = 1e4;
+    // Rotor locked: a breakaway torque (the largest a rig may have) 90× the motor's torque
+    // at 10 A.
+    rig.shaft.static_nm = 1e3;
+    rig.shaft.coulomb_nm = 1e3;
     rig.inverter.pwm_frequency_hz = pwm_hz;
     let config = closed_loop::controller_config(&rig);
     config.validate().expect("controller configuration");

@@ -1,24 +1,35 @@
-//! `cargo xtask test` — every check the project has, in the order CI runs them:
+//! `cargo xtask test` — every check the project has, in the order CI runs them, on a fresh
+//! machine too:
 //!
-//! 1. the `thumbv7em-none-eabihf` target (installed with rustup when missing);
+//! 1. what it needs installed when missing ([`setup`]): the `thumbv7em-none-eabihf` target
+//!    (rustup), `qemu-system-arm` and `tmux` (apt-get), Python's `cantools` (a virtual
+//!    environment);
 //! 2. `cargo fmt --check` and `cargo clippy --workspace --all-targets -D warnings`;
 //! 3. the host tests of the whole workspace;
-//! 4. the firmware for the STM32G474RE with warnings denied, and its flash and static-RAM
+//! 4. the CAN DBC file: in sync with `firmware::can_protocol` ([`dbc`]), and cantools
+//!    against the firmware's codec both ways ([`can_check`]);
+//! 5. the firmware for the STM32G474RE with warnings denied, and its flash and static-RAM
 //!    use against the budget (96 KiB / 16 KiB, so it also fits an STM32G431xB with the
-//!    parameter pages), written to `target/firmware-size.json`.
-//!
-//! 5. the processor-in-the-loop run in QEMU ([`pil`]): the control core and the plant on
+//!    parameter pages), written to `target/firmware-size.json`;
+//! 6. the processor-in-the-loop run in QEMU ([`pil`]): the control core and the plant on
 //!    the Cortex-M4F, telemetry through defmt and `eha ingest`, compared with the host run,
-//!    instruction counts against `pil/budget.toml`, figures in `target/pil/report.json`.
+//!    instruction counts against `pil/budget.toml`, figures in `target/pil/report.json`;
+//!    the same telemetry piped into `eha watch` under tmux ([`watch_check`]): its screen
+//!    checked, its bench log equal to `eha ingest`'s.
 //!
-//! `cargo xtask fw-size` does step 4 alone, `cargo xtask pil` step 5.
+//! `cargo xtask fw-size` does step 5 alone, `cargo xtask pil` step 6, `cargo xtask can`
+//! step 4; `cargo xtask dbc [--node N] [--out FILE]` writes the DBC file.
 
 use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod can_check;
+mod dbc;
 mod pil;
+mod setup;
+mod watch_check;
 
 const TARGET: &str = "thumbv7em-none-eabihf";
 /// 96 KiB: an STM32G431xB (128 KiB) still holds the image and the parameter store's pages.
@@ -30,9 +41,15 @@ fn main() {
     let result = match args.first().map(String::as_str) {
         Some("test") => test(),
         Some("fw-size") => firmware().map(|_| ()),
-        Some("pil") => ensure_target().and_then(|()| pil::pil()),
+        Some("pil") => ensure_target()
+            .and_then(|()| setup::tools())
+            .and_then(|()| pil::pil()),
+        Some("dbc") => dbc::dbc(&args[1..]),
+        Some("can") => can(),
         _ => {
-            eprintln!("usage: cargo xtask <test | fw-size | pil>");
+            eprintln!(
+                "usage: cargo xtask <test | fw-size | pil | can | dbc [--node N] [--out FILE]>"
+            );
             std::process::exit(2);
         }
     };
@@ -92,8 +109,17 @@ fn ensure_target() -> Result<()> {
     Ok(())
 }
 
+/// The DBC file in sync, then cantools against the firmware's codec.
+fn can() -> Result<()> {
+    let text = dbc::generate(dbc::DEFAULT_NODE)?;
+    dbc::check_in_sync(&text, &root().join(dbc::FILE))?;
+    can_check::check(&setup::python()?)
+}
+
 fn test() -> Result<()> {
     ensure_target()?;
+    setup::tools()?;
+    let python = setup::python()?;
     run("format", cargo().args(["fmt", "--all", "--", "--check"]))?;
     run(
         "lint",
@@ -107,6 +133,9 @@ fn test() -> Result<()> {
         ]),
     )?;
     run("host tests", cargo().args(["test", "--workspace"]))?;
+    let text = dbc::generate(dbc::DEFAULT_NODE)?;
+    dbc::check_in_sync(&text, &root().join(dbc::FILE))?;
+    can_check::check(&python)?;
     firmware()?;
     pil::pil()?;
     eprintln!("\nxtask: all checks passed");

@@ -1,9 +1,10 @@
 //! The processor-in-the-loop step of `cargo xtask test`: the `pil` binary built for the
 //! Cortex-M4F and run in `qemu-system-arm -machine mps2-an386 -icount shift=0`; its defmt
 //! frames decoded with the ELF's table (`defmt-decoder`); the telemetry turned into a bench
-//! log by `eha ingest`; the same scenario run on the host by `eha simulate` and the two logs
-//! compared sample by sample; the figures written to `target/pil/report.json`; the
-//! current-loop step's instruction count checked against `pil/budget.toml`.
+//! log by `eha ingest`, and piped into `eha watch` in tmux (`watch_check`); the same
+//! scenario run on the host by `eha simulate` and the two logs compared sample by sample;
+//! the figures written to `target/pil/report.json`; the current-loop step's instruction
+//! count checked against `pil/budget.toml`.
 
 use anyhow::{bail, Context, Result};
 use defmt_decoder::{DecodeError, Table};
@@ -88,6 +89,8 @@ pub fn pil() -> Result<()> {
             path_str(&pil_csv)?,
         ]),
     )?;
+    let eha_bin = crate::target_dir().join("debug").join("eha");
+    crate::watch_check::check(&eha_bin, &defmt_log, &pil_csv, &out_dir)?;
     crate::run(
         "eha simulate (same scenario on the host)",
         eha().args([

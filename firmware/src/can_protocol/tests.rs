@@ -379,3 +379,26 @@ fn function_codes_are_the_identifier_base_shifted() {
     }
     assert_eq!(Function::from_code(0x18), None);
 }
+
+#[test]
+fn the_all_lists_hold_every_code_the_decoders_accept() {
+    // The DBC file and the host tools enumerate the protocol through these lists.
+    for code in 0..=u8::MAX {
+        assert_eq!(
+            Function::from_code(code),
+            Function::ALL.into_iter().find(|f| f.code() == code),
+            "function {code:#x}"
+        );
+        assert_eq!(
+            RejectReason::from_code(code),
+            RejectReason::ALL.into_iter().find(|r| r.code() == code),
+            "reason {code}"
+        );
+        assert_eq!(
+            StepLoop::from_code(code),
+            StepLoop::ALL.into_iter().find(|l| l.code() == code),
+            "step loop {code}"
+        );
+        assert_eq!(Mode::from_code(code).is_some(), code <= MODE_CODE_MAX);
+    }
+}

@@ -267,10 +267,7 @@ impl BenchLog {
             problem,
         };
         for (i, (k, v)) in self.metadata.iter().enumerate() {
-            if k.trim().is_empty() || k.contains([':', '\n', '\r']) || k.trim() != k {
-                return Err(content(i + 1, k, Problem::BadMetadata));
-            }
-            if v.contains(['\n', '\r']) {
+            if !metadata_fits(k, v) {
                 return Err(content(i + 1, k, Problem::BadMetadata));
             }
         }
@@ -532,8 +529,16 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
         if starts_meta {
             let text = line.trim_start_matches('\u{feff}').trim_start_matches('#');
             let (k, v) = text.split_once(':').unwrap_or((text, ""));
-            log.metadata
-                .push((k.trim().to_string(), v.trim().to_string()));
+            let (k, v) = (k.trim(), v.trim());
+            if k.is_empty() && v.is_empty() {
+                continue; // a bare `#`: nothing to keep, like a blank line
+            }
+            // What the writer could not write back (an empty key, a carriage return inside
+            // the value) is refused here too, so every log read can be written.
+            if !metadata_fits(k, v) {
+                return Err(err(consumed, k, Problem::BadMetadata));
+            }
+            log.metadata.push((k.to_string(), v.to_string()));
         }
     }
 
@@ -661,6 +666,15 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
         ));
     }
     Ok(log)
+}
+
+/// Whether a metadata line `# k: v` can be written and read back as this key and value: a
+/// non-empty key without `:`, line breaks or surrounding blanks, a value on one line.
+fn metadata_fits(k: &str, v: &str) -> bool {
+    !k.trim().is_empty()
+        && !k.contains([':', '\n', '\r'])
+        && k.trim() == k
+        && !v.contains(['\n', '\r'])
 }
 
 /// Whether `v` lies outside the physical range of `signal`'s column.

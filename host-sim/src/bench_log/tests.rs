@@ -249,3 +249,20 @@ fn format_is_shortest_round_trip() {
     assert_eq!(f(-2.5e20), "-2.5e20");
     assert_eq!(f(0.0), "0");
 }
+
+#[test]
+fn metadata_the_writer_cannot_write_is_refused_on_reading() {
+    // Found by fuzzing: a carriage return inside a value was read, and the log could not
+    // be written back.
+    let body = log_text(100, HEADER, good_row);
+    let cr = format!("# source: a\rb\n{body}");
+    let (l, c, p) = content_error(&cr);
+    assert_eq!((l, c.as_str(), p), (1, "source", Problem::BadMetadata));
+    let (l, _, p) = content_error(&format!("#: value\n{body}"));
+    assert_eq!((l, p), (1, Problem::BadMetadata));
+    // A bare `#` line is skipped like a blank one; a CRLF line end is no carriage return
+    // inside.
+    let ok = parse_str(&format!("#\r\n# rig: x\r\n{body}")).unwrap();
+    assert_eq!(ok.meta("rig"), Some("x"));
+    assert!(ok.check(Path::new("t.csv")).is_ok());
+}

@@ -50,9 +50,10 @@ pub const HYDRAULIC_WINDOW_S: f64 = 0.25;
 /// Length of a speed shooting window. [s]
 pub const SPEED_WINDOW_S: f64 = 0.05;
 
-/// Most rows a fit evaluates per model run: longer segments are thinned to evenly spread
-/// windows (a 600 s log is calibrated on a tenth of its first half). [1]
-pub const MAX_FIT_ROWS: usize = 40_000;
+/// Most rows a fit evaluates per model run: longer segments are thinned
+/// ([`thinned`]). Twelve seconds at 1 kHz fix every rig parameter the relations carry;
+/// more only narrows error bars already far inside the bands. [1]
+pub const MAX_FIT_ROWS: usize = 12_000;
 
 /// Which parameter of a relation an effect releases from its band.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -217,16 +218,43 @@ pub fn hydraulic_params(rig: &Rig, v: &[f64]) -> HydraulicParams {
     p
 }
 
-/// Evenly thinned `windows` holding at most [`MAX_FIT_ROWS`] rows together.
-pub fn thinned(windows: Vec<Range<usize>>) -> Vec<Range<usize>> {
+/// `windows` thinned to at most [`MAX_FIT_ROWS`] rows together: half of the budget to the
+/// windows where `signal` moves most (its range within the window: the steps, fills and
+/// starts where the effects show), the rest spread evenly over the others, in time order.
+pub fn thinned(windows: Vec<Range<usize>>, signal: &[f64]) -> Vec<Range<usize>> {
     let rows: usize = windows.iter().map(|w| w.len()).sum();
     if rows <= MAX_FIT_ROWS {
         return windows;
     }
-    let keep = (windows.len() * MAX_FIT_ROWS / rows).max(1);
-    let step = windows.len() as f64 / keep as f64;
-    (0..keep)
-        .filter_map(|i| windows.get((i as f64 * step) as usize).cloned())
+    let per_window = (rows / windows.len().max(1)).max(1);
+    let keep = (MAX_FIT_ROWS / per_window).clamp(1, windows.len());
+    let range = |w: &Range<usize>| {
+        let s = &signal[w.clone()];
+        let (lo, hi) = s
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                (l.min(*v), h.max(*v))
+            });
+        hi - lo
+    };
+    let mut by_motion: Vec<usize> = (0..windows.len()).collect();
+    by_motion.sort_by(|a, b| range(&windows[*b]).total_cmp(&range(&windows[*a])));
+    let mut chosen = vec![false; windows.len()];
+    for &i in by_motion.iter().take(keep / 2) {
+        chosen[i] = true;
+    }
+    let rest: Vec<usize> = (0..windows.len()).filter(|i| !chosen[*i]).collect();
+    let even = keep - keep / 2;
+    let step = rest.len() as f64 / even.max(1) as f64;
+    for k in 0..even {
+        if let Some(&i) = rest.get((k as f64 * step) as usize) {
+            chosen[i] = true;
+        }
+    }
+    windows
+        .into_iter()
+        .zip(chosen)
+        .filter_map(|(w, c)| c.then_some(w))
         .collect()
 }
 
@@ -548,8 +576,30 @@ pub fn calibrate<R: Relation>(relation: &R, rows: &[Range<usize>]) -> Calibratio
     let scale0 = variance_per_independent_sample(&relation.residuals(&nominal, rows));
     let first = fit_relation(relation, rows, Release::Nothing, scale0, None);
     let scale = variance_per_independent_sample(&relation.residuals(&first.values, rows));
-    let fitted = fit_relation(relation, rows, Release::Nothing, scale, Some(&first.values));
+    let fitted = reweighed(relation, rows, Release::Nothing, &first, scale0, scale);
     Calibration { fitted, scale }
+}
+
+/// `f`, fitted with the residuals weighed by 1/`from`, as weighed by 1/`to`. Without
+/// priors the weight is a constant factor of the objective: the optimum stays, the sums
+/// of squares and the covariance scale. With priors the fit is redone.
+fn reweighed<R: Relation>(
+    relation: &R,
+    rows: &[Range<usize>],
+    release: Release,
+    f: &Fitted,
+    from: f64,
+    to: f64,
+) -> Fitted {
+    if relation.specs(release).iter().any(|s| s.prior.is_some()) {
+        return fit_relation(relation, rows, release, to, Some(&f.values));
+    }
+    let k = from / to.max(f64::MIN_POSITIVE);
+    Fitted {
+        data_sse: f.data_sse * k,
+        covariance_u: f.covariance_u.as_ref().map(|c| c / k),
+        ..f.clone()
+    }
 }
 
 /// One effect's test on a relation: its parameter released from its band against the
@@ -605,13 +655,14 @@ pub fn test_release<R: Relation>(
     let first = fit_relation(relation, rows, release, base.scale, Some(&start));
     let scale =
         variance_per_independent_sample(&relation.residuals(&first.values, rows)).min(base.scale);
-    let fitted = fit_relation(relation, rows, release, scale, Some(&first.values));
-    let baseline = fit_relation(
+    let fitted = reweighed(relation, rows, release, &first, base.scale, scale);
+    let baseline = reweighed(
         relation,
         rows,
         Release::Nothing,
+        &base.fitted,
+        base.scale,
         scale,
-        Some(&base.fitted.values),
     );
     let objective = |f: &Fitted| f.data_sse + f.prior_sse;
     ReleaseTest {

@@ -33,7 +33,15 @@ pub mod ix {
     pub const VISCOUS: usize = 1;
     /// Coulomb friction.
     pub const COULOMB: usize = 2;
+    /// Low-side pressure, when it is not logged.
+    pub const LOW_SIDE: usize = 3;
 }
+
+/// Tolerance band of the low side's (fill) pressure when the log does not have it: the
+/// rig contract's 0.5 MPa is assumed, boost circuits are set anywhere in this range.
+/// Along a one-way stroke it and the Coulomb force are the same constant pressure step:
+/// there the friction is named only beyond what this band explains. [Pa]
+pub const LOW_SIDE_BAND_PA: (f64, f64) = (0.2e6, 1.0e6);
 
 /// Upper end of the cylinder Coulomb friction's tolerance band, as a multiple of the rig
 /// file's (seals wear in and out). [1]
@@ -76,8 +84,9 @@ impl<'a> CylinderRelation<'a> {
         c.mass_kg = values[ix::MASS];
         let cyl = Cylinder::new(&c);
         let area = c.area_m2;
+        let low_side = values.get(ix::LOW_SIDE).copied();
         for k in rows {
-            let p_low = self.facts.p_low_pa[k];
+            let p_low = low_side.unwrap_or(self.facts.p_low_pa[k]);
             // drive_force(p, p_low) = A·(p − p_low) − rest; solve m·a + F_c·sgn(v) = it.
             let rest = -cyl.drive_force(0.0, 0.0, self.x[k], self.v[k], 0.0);
             let friction = values[ix::COULOMB] * (self.v[k] / COULOMB_FADE_M_S).tanh();
@@ -96,7 +105,7 @@ impl Relation for CylinderRelation<'_> {
         } else {
             coulomb.with_band(0.0, COULOMB_BAND * nominal.max(10.0))
         };
-        vec![
+        let mut specs = vec![
             ParamSpec::log("mass_kg", c.mass_kg, 0.3, 3.0)
                 .with_band(0.9 * c.mass_kg, 1.1 * c.mass_kg),
             ParamSpec::log(
@@ -107,7 +116,13 @@ impl Relation for CylinderRelation<'_> {
             )
             .with_band(0.5 * c.viscous_n_s_per_m, 2.0 * c.viscous_n_s_per_m),
             coulomb,
-        ]
+        ];
+        if self.log.p_low_pa.is_none() {
+            let (lo, hi) = LOW_SIDE_BAND_PA;
+            let fill = self.rig.fill.pressure_pa.clamp(lo, hi);
+            specs.push(ParamSpec::linear("low_side_pa", fill, 1e4, 0.0, 5e6).with_band(lo, hi));
+        }
+        specs
     }
 
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {

@@ -78,6 +78,11 @@ pub struct LogFacts {
     pub p_low_pa: Vec<f64>,
     /// Whether the piston moves (`x_m` logged and travelling).
     pub piston_moves: bool,
+    /// Whether the piston moves but `x_m` is not logged: the pump displaced far more oil
+    /// than the high side can store and leak ([`unseen_piston_motion`]). The pressure's
+    /// volume balance then lacks its largest flow, and the hydraulic effects cannot be
+    /// tested.
+    pub piston_unseen: bool,
     /// First row of the validation segment (identification is `start..split`).
     pub split: usize,
     /// First row scored: the log's first [`START_SKIP_S`] hold the logger's and the
@@ -115,6 +120,7 @@ impl LogFacts {
                 });
             hi - lo > MOVING_PISTON_TRAVEL_M
         });
+        let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, &p_low_pa, rig);
         let t_half = t[0] + 0.5 * (t[rows - 1] - t[0]);
         let split = t.partition_point(|x| *x < t_half).clamp(1, rows - 1);
         let start = t
@@ -145,6 +151,7 @@ impl LogFacts {
             angle_logged,
             p_low_pa,
             piston_moves,
+            piston_unseen,
             split,
             start,
             noise_rms,
@@ -303,6 +310,37 @@ fn steady_windows(t: &[f64], theta: &[f64], period_s: f64) -> Vec<SteadyWindow> 
         keep(s0..(start).min(n), &mut out);
     }
     out
+}
+
+/// Whether a log without the piston's position shows it moving: the oil the pump
+/// displaced, ∫ D/2π·|ω| dt, is more than twice what the high side could take — its
+/// oil's compression over the logged pressure range, the whole absorber shell if the
+/// pressure rose above its precharge, and twice the rig's leakage — plus a cubic
+/// centimetre. A blocked cylinder's pump only replaces leakage and compression. [m³]
+pub fn unseen_piston_motion(log: &BenchLog, p_low_pa: &[f64], rig: &Rig) -> bool {
+    let d_per_rad = rig.pump.displacement_m3_per_rev / (2.0 * PI);
+    let leakage = rig.pump.internal_leakage_m3_s_pa
+        + rig.pump.external_leakage_m3_s_pa
+        + rig.cylinder.internal_leakage_m3_s_pa;
+    let (mut displaced, mut leaked) = (0.0, 0.0);
+    for (k, p_low) in p_low_pa.iter().enumerate().skip(1) {
+        let dt = log.t_s[k] - log.t_s[k - 1];
+        displaced += d_per_rad * log.speed_rad_s[k].abs() * dt;
+        leaked += 2.0 * leakage * (log.p_pa[k] - p_low).abs() * dt;
+    }
+    let (lo, hi) = log
+        .p_pa
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(*p), h.max(*p))
+        });
+    let compression = rig.cylinder.chamber_a_volume_m3 / rig.oil.bulk_modulus_pa * (hi - lo);
+    let absorber = if rig.absorber.enabled && hi > rig.absorber.precharge_pa {
+        rig.absorber.shell_volume_m3
+    } else {
+        0.0
+    };
+    displaced > 2.0 * (compression + absorber + leaked) + 1e-6
 }
 
 #[cfg(test)]

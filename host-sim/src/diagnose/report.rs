@@ -7,7 +7,7 @@
 
 use super::analysis::Analysis;
 use crate::output::CliError;
-use crate::plots::{line_chart, Marker, Series};
+use crate::plots::{line_chart, png, stacked_chart, Marker, Panel, Series};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -21,6 +21,77 @@ fn decimated(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
         .step_by(step)
         .map(|(a, b)| (*a, *b))
         .collect()
+}
+
+/// Links a figure in the report (its PNG, readable in any viewer, and the SVG) and lists
+/// both files for the move out of the staging folder.
+fn figure(md: &mut String, files: &mut Vec<String>, what: &str, svg: &str) {
+    let png = png::beside(Path::new(svg)).display().to_string();
+    let _ = writeln!(md, "![{what}]({png}) ([SVG]({svg}))\n");
+    files.push(svg.to_string());
+    files.push(png);
+}
+
+/// A signal's figure: measured, nominal and extended model above; beneath, on its own
+/// scale, the residual of each model (measured − model). `[y, b, e]` are the measured,
+/// nominal and extended series over `t`; the validation segment starts at `t_val`.
+fn trace_figure(
+    path: &Path,
+    signal: &str,
+    t: &[f64],
+    [y, b, e]: [&Vec<f64>; 3],
+    t_val: f64,
+) -> Result<(), String> {
+    let residual = |m: &[f64]| -> Vec<f64> { y.iter().zip(m).map(|(y, m)| y - m).collect() };
+    let traces = [
+        Series {
+            name: "measured",
+            points: decimated(t, y),
+        },
+        Series {
+            name: "nominal model",
+            points: decimated(t, b),
+        },
+        Series {
+            name: "extended model",
+            points: decimated(t, e),
+        },
+    ];
+    let residuals = [
+        Series {
+            name: "measured - nominal",
+            points: decimated(t, &residual(b)),
+        },
+        Series {
+            name: "measured - extended",
+            points: decimated(t, &residual(e)),
+        },
+    ];
+    let validation = [Marker {
+        x: t_val,
+        label: "validation →",
+    }];
+    let signal_label = format!("{signal} [{}]", unit_of(signal));
+    let residual_label = format!("residual [{}]", unit_of(signal));
+    stacked_chart(
+        path,
+        &format!("{signal}: measured, nominal model, extended model; the residuals beneath"),
+        "t [s]",
+        &[
+            Panel::new(&signal_label, &traces)
+                .markers(&validation)
+                .weight(3)
+                .robust()
+                .measured_first(),
+            Panel::new(&residual_label, &residuals).weight(2).robust(),
+        ],
+    )
+}
+
+/// The unit a bench-log column's name ends in.
+fn unit_of(signal: &str) -> &'static str {
+    crate::bench_log::Signal::from_name(signal)
+        .map_or("", |s| crate::bench_log::limits::physical_range(s).2)
 }
 
 fn failed(what: &str, e: impl std::fmt::Display) -> CliError {
@@ -44,7 +115,7 @@ pub fn write_report(dir: &Path, log_path: &Path, analysis: &Analysis) -> Result<
     let result = render(&staging, log_path, analysis).and_then(|files| {
         std::fs::create_dir_all(dir).map_err(|e| failed(&dir.display().to_string(), e))?;
         for f in files {
-            std::fs::rename(staging.join(&f), dir.join(&f))
+            crate::output::atomic::rename_into(&staging.join(&f), &dir.join(&f))
                 .map_err(|e| failed(&dir.join(&f).display().to_string(), e))?;
         }
         Ok(())
@@ -147,34 +218,15 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
             continue;
         };
         let file = format!("trace_{s}.svg");
-        line_chart(
+        trace_figure(
             &dir.join(&file),
-            &format!("{s}: measured, nominal model, extended model"),
-            "t [s]",
             s,
-            &[
-                Series {
-                    name: "measured",
-                    points: decimated(&a.t_s, y),
-                },
-                Series {
-                    name: "nominal model",
-                    points: decimated(&a.t_s, b),
-                },
-                Series {
-                    name: "extended model",
-                    points: decimated(&a.t_s, e),
-                },
-            ],
-            &[Marker {
-                x: d.validation_segment_s[0],
-                label: "validation →",
-            }],
-            false,
+            &a.t_s,
+            [y, b, e],
+            d.validation_segment_s[0],
         )
         .map_err(|e| failed(&file, e))?;
-        let _ = writeln!(md, "![{s}]({file})\n");
-        files.push(file);
+        figure(&mut md, &mut files, s, &file);
     }
     let _ = writeln!(md, "## Residual order spectra (nominal model)\n");
     let labels: Vec<String> = a
@@ -217,8 +269,12 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
             true,
         )
         .map_err(|e| failed(&file, e))?;
-        let _ = writeln!(md, "![{s} residual spectrum]({file})\n");
-        files.push(file);
+        figure(
+            &mut md,
+            &mut files,
+            &format!("{s} residual spectrum"),
+            &file,
+        );
     }
     crate::output::atomic::write(&dir.join("report.md"), md.as_bytes())
         .map_err(|e| failed("report.md", e))?;

@@ -44,6 +44,13 @@ where
     result
 }
 
+/// Moves the finished file `from` onto `to` (same file system), with [`write`]'s rules for
+/// what `to` may be: a symbolic link is followed, a special file is never replaced.
+pub fn rename_into(from: &Path, to: &Path) -> io::Result<()> {
+    let target = super::paths::replaced_file(to)?.unwrap_or_else(|| to.to_path_buf());
+    fs::rename(from, target)
+}
+
 /// `dir/.name.tmp-<pid>-<n>`: same directory (rename must not cross file systems), hidden,
 /// unique.
 fn temporary_path(path: &Path) -> io::Result<PathBuf> {

@@ -174,6 +174,14 @@ pub fn replaced_file(path: &Path) -> io::Result<Option<PathBuf>> {
     }
 }
 
+/// Checks a file a subcommand writes into its output folder: nothing there yet, a regular
+/// file, or a link to one (the folder itself is checked by [`output_dir`]).
+pub fn replaceable(flag: &str, path: &Path) -> Result<(), CliError> {
+    replaced_file(path)
+        .map(|_| ())
+        .map_err(|e| bad(flag, path, describe(&e)))
+}
+
 /// Checks an output file path (`-` is standard output and always fine) against the inputs
 /// it must not overwrite.
 pub fn output_file(flag: &str, path: &Path, inputs: &[&Path]) -> Result<(), CliError> {

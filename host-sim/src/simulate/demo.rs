@@ -1,21 +1,24 @@
 //! `eha demo`: the paper's low-speed pressure holding in closed loop with and without the
-//! absorber, a pressure step and a speed step — a summary table, the runs' bench logs and
+//! absorber, each again with the torque feed-forward learned by the bench procedure
+//! (`crate::compensate`), a pressure step and a speed step — a summary table, the runs' bench logs and
 //! SVG plots in an output folder.
 
 use super::holding::pulsation;
 use super::{converged, effects_text, plant_rig, rig_name, write_log, LOG_RATE_HZ};
-use crate::output::paths::Declared;
+use crate::output::paths::{replaceable, Declared};
 use crate::output::{print_stdout, CliError};
-use crate::plots::{line_chart, Marker, Series};
+use crate::plots::{line_chart, stacked_chart, Marker, Panel, Series};
 use crate::pulsation::sources;
 use crate::run::{run, Run, RunOptions};
 use clap::Args;
 use closed_loop::{by_name, Scenario};
+use firmware::compensation::record::{Encoder, RECORD_LEN};
+use firmware::compensation::Table;
 use plant_model::effects::paper_low_speed_effects;
 use plant_model::{Effect, Rig};
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `eha demo`.
 #[derive(Debug, Args)]
@@ -32,12 +35,43 @@ impl DemoArgs {
     }
 }
 
-/// A demo run: plant rig, controller rig, scenario, duration [s], log metadata.
-type Job<'a> = (&'a Rig, &'a Rig, &'a Scenario, f64, Vec<(String, String)>);
+/// The files the demo writes into its folder (each figure an SVG and a PNG).
+const FILES: [&str; 14] = [
+    "pressure-hold.csv",
+    "pressure-hold-no-absorber.csv",
+    "pressure-step.csv",
+    "speed-step.csv",
+    "compensation-sweep.csv",
+    "compensation.table",
+    "pressure_trace.svg",
+    "pulsation_spectrum.svg",
+    "pressure_step.svg",
+    "speed_step.svg",
+    "pressure_trace.png",
+    "pulsation_spectrum.png",
+    "pressure_step.png",
+    "speed_step.png",
+];
+
+/// A demo run: plant rig, controller rig, scenario, duration [s], log metadata, the torque
+/// feed-forward table loaded (if any).
+type Job<'a> = (
+    &'a Rig,
+    &'a Rig,
+    &'a Scenario,
+    f64,
+    Vec<(String, String)>,
+    Option<&'a Table>,
+);
 
 /// `eha demo`.
 pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     let out = &args.out;
+    // Checked before the runs: every file is written atomically and never over a special
+    // file, but a refusal after minutes of work would leave the folder half updated.
+    for name in FILES {
+        replaceable("--out", &out.join(name))?;
+    }
     std::fs::create_dir_all(out).map_err(|source| CliError::Write {
         file: out.clone(),
         source,
@@ -65,15 +99,43 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             ("absorber".into(), absorber.into()),
         ]
     };
-    // Three runs in parallel: holding with and without the absorber, and a pressure step.
+    // The torque feed-forward learned as a bench would: the drive's sweep and a 12 s hold
+    // at 5 MPa, `eha compensate`'s model method.
+    let (ff_table, ff_logs) = crate::compensate::study::bench_learning(rig, &plant, 12.0)?;
+    // In parallel: holding with and without the absorber, each without and with the
+    // feed-forward, a pressure step and a speed step.
     let jobs: Vec<Job> = vec![
-        (&plant, rig, hold, 4.0, meta("pressure-hold", "fitted")),
+        (
+            &plant,
+            rig,
+            hold,
+            4.0,
+            meta("pressure-hold", "fitted"),
+            None,
+        ),
         (
             &bare,
             &bare_controller,
             hold,
             4.0,
             meta("pressure-hold", "none"),
+            None,
+        ),
+        (
+            &plant,
+            rig,
+            hold,
+            4.0,
+            meta("pressure-hold", "fitted, feed-forward"),
+            Some(&ff_table),
+        ),
+        (
+            &bare,
+            &bare_controller,
+            hold,
+            4.0,
+            meta("pressure-hold", "none, feed-forward"),
+            Some(&ff_table),
         ),
         (
             &plant,
@@ -81,12 +143,20 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             step,
             step.duration_s,
             meta("pressure-step", "fitted"),
+            None,
         ),
-        (&plant, rig, speed_step, 0.4, meta("speed-step", "fitted")),
+        (
+            &plant,
+            rig,
+            speed_step,
+            0.4,
+            meta("speed-step", "fitted"),
+            None,
+        ),
     ];
     let runs: Vec<Result<Run, String>> = jobs
         .par_iter()
-        .map(|(p, c, sc, d, m)| {
+        .map(|(p, c, sc, d, m, table)| {
             run(
                 p,
                 c,
@@ -97,7 +167,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
                     seed: 1,
                     progress: false,
                     metadata: m.clone(),
-                    compensation: None,
+                    compensation: table.cloned(),
                 },
             )
         })
@@ -109,48 +179,19 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             .map_err(CliError::Failed)
             .and_then(converged)
     };
-    let (with, without, stepped, sped) = (next()?, next()?, next()?, next()?);
+    let (with, without) = (next()?, next()?);
+    let (with_ff, without_ff) = (next()?, next()?);
+    let (stepped, sped) = (next()?, next()?);
     let pw = pulsation(&with, hold, &plant);
     let po = pulsation(&without, hold, &plant);
-    // The torque feed-forward learned by the bench procedure (the drive's sweep and a
-    // 12 s hold), then the holding again with it, with and without the absorber.
-    let (ff_table, ff_logs) = crate::compensate::study::bench_learning(rig, &plant, 12.0)?;
-    let ff_runs: Vec<Result<Run, String>> = [(&plant, rig), (&bare, &bare_controller)]
-        .par_iter()
-        .map(|(p, c)| {
-            run(
-                p,
-                c,
-                hold,
-                &RunOptions {
-                    duration_s: 4.0,
-                    log_rate_hz: LOG_RATE_HZ,
-                    seed: 1,
-                    progress: false,
-                    metadata: meta("pressure-hold", "feed-forward"),
-                    compensation: Some(ff_table.clone()),
-                },
-            )
-        })
-        .collect();
-    let mut ff_runs = ff_runs.into_iter();
-    let mut next_ff = || {
-        ff_runs
-            .next()
-            .unwrap_or_else(|| Err("run missing".into()))
-            .map_err(CliError::Failed)
-            .and_then(converged)
-    };
-    let (with_ff, without_ff) = (next_ff()?, next_ff()?);
     let pwf = pulsation(&with_ff, hold, &plant);
     let pof = pulsation(&without_ff, hold, &plant);
-    let mut record = [0u8; firmware::compensation::record::RECORD_LEN];
-    firmware::compensation::record::Encoder::write_all(&ff_table, &mut record);
-    crate::output::atomic::write(&out.join("compensation.table"), &record).map_err(|source| {
-        CliError::Write {
-            file: out.join("compensation.table"),
-            source,
-        }
+    let mut record = [0u8; RECORD_LEN];
+    Encoder::write_all(&ff_table, &mut record);
+    let table_path = out.join("compensation.table");
+    crate::output::atomic::write(&table_path, &record).map_err(|source| CliError::Write {
+        file: table_path.clone(),
+        source,
     })?;
     write_log(&out.join("compensation-sweep.csv"), &ff_logs[0])?;
 
@@ -222,57 +263,16 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     );
 
     // Plots.
-    let t_from = hold.steady_from_s;
-    let trace = |r: &Run, measured: bool| -> Vec<(f64, f64)> {
-        r.log
-            .t_s
-            .iter()
-            .enumerate()
-            .filter(|(_, t)| **t >= t_from)
-            .map(|(i, t)| {
-                (
-                    *t,
-                    if measured {
-                        r.log.p_pa[i]
-                    } else {
-                        r.p_true_pa[i]
-                    } / 1e6,
-                )
-            })
-            .collect()
-    };
+    pressure_figure(
+        &out.join("pressure_trace.svg"),
+        &with,
+        &without,
+        &without_ff,
+        hold.steady_from_s,
+    )?;
     let plot = |name: &str, res: Result<(), String>| {
         res.map_err(|e| CliError::Failed(format!("{name}: {e}")))
     };
-    plot(
-        "pressure trace",
-        line_chart(
-            &out.join("pressure_trace.svg"),
-            "Port-A pressure, holding at 5 MPa",
-            "t [s]",
-            "p [MPa]",
-            &[
-                Series {
-                    name: "measured (transducer), absorber fitted",
-                    points: trace(&with, true),
-                },
-                Series {
-                    name: "true, absorber fitted",
-                    points: trace(&with, false),
-                },
-                Series {
-                    name: "true, no absorber",
-                    points: trace(&without, false),
-                },
-                Series {
-                    name: "true, no absorber, torque feed-forward",
-                    points: trace(&without_ff, false),
-                },
-            ],
-            &[],
-            false,
-        ),
-    )?;
     let rev_s = pw.speed_rad_s / (2.0 * std::f64::consts::PI);
     let srcs = sources(&plant);
     let markers: Vec<Marker> = srcs
@@ -346,54 +346,98 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             false,
         ),
     )?;
-    let speed_ref = sped.log.speed_ref_rad_s.clone().unwrap_or_default();
-    plot(
-        "speed step",
-        line_chart(
-            &out.join("speed_step.svg"),
-            "Speed step 0 → 50 rad/s (payload free)",
-            "t [s]",
-            "speed [rad/s], q-current [A]",
-            &[
-                Series {
-                    name: "speed reference",
-                    points: sped
-                        .log
-                        .t_s
-                        .iter()
-                        .zip(&speed_ref)
-                        .map(|(t, w)| (*t, *w))
-                        .collect(),
-                },
-                Series {
-                    name: "true shaft speed",
-                    points: sped
-                        .log
-                        .t_s
-                        .iter()
-                        .zip(&sped.speed_true_rad_s)
-                        .map(|(t, w)| (*t, *w))
-                        .collect(),
-                },
-                Series {
-                    name: "measured q-current",
-                    points: sped
-                        .log
-                        .t_s
-                        .iter()
-                        .zip(&sped.log.iq_a)
-                        .map(|(t, i)| (*t, *i))
-                        .collect(),
-                },
-            ],
-            &[],
-            false,
-        ),
-    )?;
+    speed_figure(&out.join("speed_step.svg"), &sped)?;
     let _ = writeln!(
         table,
-        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, compensation-sweep.csv, compensation.table, pressure_trace.svg, pulsation_spectrum.svg, pressure_step.svg, speed_step.svg",
+        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, compensation-sweep.csv (the feed-forward's bench sweep), compensation.table, pressure_trace, pulsation_spectrum, pressure_step, speed_step (each .svg and .png)",
         out.display()
     );
     print_stdout(&table)
+}
+
+/// Seconds of the steady hold the pressure figure shows: enough for the slowest line
+/// (the shaft's once per revolution at the demo's ~0.9 rev/s), few enough that each cycle
+/// of the pump's and the motor's lines stays distinct.
+const PRESSURE_FIGURE_S: f64 = 1.2;
+
+/// The demo's point in one figure: the true port-A pressure with and without the absorber
+/// about the 5 MPa setpoint, on a scale the pulsation fills; beneath it, on its own scale,
+/// what the transducer reads with the absorber fitted (its noise and quantisation are
+/// larger than the absorbed pulsation).
+fn pressure_figure(
+    path: &Path,
+    with: &Run,
+    without: &Run,
+    without_ff: &Run,
+    steady_from_s: f64,
+) -> Result<(), CliError> {
+    let t_end = with.log.t_s.last().copied().unwrap_or(0.0);
+    let t_from = steady_from_s.max(t_end - PRESSURE_FIGURE_S);
+    let kpa_about_5mpa = |t: &[f64], p: &[f64]| -> Vec<(f64, f64)> {
+        t.iter()
+            .zip(p)
+            .filter(|(t, _)| **t >= t_from)
+            .map(|(t, p)| (*t, (p - 5e6) / 1e3))
+            .collect()
+    };
+    let truth = [
+        Series {
+            name: "true, no absorber",
+            points: kpa_about_5mpa(&without.log.t_s, &without.p_true_pa),
+        },
+        Series {
+            name: "true, no absorber, torque feed-forward",
+            points: kpa_about_5mpa(&without_ff.log.t_s, &without_ff.p_true_pa),
+        },
+        Series {
+            name: "true, absorber fitted",
+            points: kpa_about_5mpa(&with.log.t_s, &with.p_true_pa),
+        },
+    ];
+    let measured = [Series {
+        name: "measured (transducer), absorber fitted",
+        points: kpa_about_5mpa(&with.log.t_s, &with.log.p_pa),
+    }];
+    stacked_chart(
+        path,
+        "Port-A pressure holding 5 MPa: the pulsation with and without the absorber",
+        "t [s]",
+        &[
+            Panel::new("true p - 5 MPa [kPa]", &truth).weight(3),
+            Panel::new("measured p - 5 MPa [kPa]", &measured).weight(2),
+        ],
+    )
+    .map_err(|e| CliError::Failed(format!("pressure trace: {e}")))
+}
+
+/// The speed step: reference and true speed above, the q current that drives it beneath,
+/// each on its own scale.
+fn speed_figure(path: &Path, sped: &Run) -> Result<(), CliError> {
+    let t = &sped.log.t_s;
+    let pairs = |y: &[f64]| -> Vec<(f64, f64)> { t.iter().zip(y).map(|(t, y)| (*t, *y)).collect() };
+    let speed_ref = sped.log.speed_ref_rad_s.clone().unwrap_or_default();
+    let speed = [
+        Series {
+            name: "speed reference",
+            points: pairs(&speed_ref),
+        },
+        Series {
+            name: "true shaft speed",
+            points: pairs(&sped.speed_true_rad_s),
+        },
+    ];
+    let current = [Series {
+        name: "measured q current",
+        points: pairs(&sped.log.iq_a),
+    }];
+    stacked_chart(
+        path,
+        "Speed step 0 → 50 rad/s (payload free)",
+        "t [s]",
+        &[
+            Panel::new("speed [rad/s]", &speed).weight(3),
+            Panel::new("q current [A]", &current).weight(2),
+        ],
+    )
+    .map_err(|e| CliError::Failed(format!("speed step: {e}")))
 }

@@ -3,7 +3,7 @@
 //! steady pulsation of each against the reference, with the absorber's natural frequency
 //! and damping at the run's mean pressure; optionally the runs' bench logs and plots.
 
-use crate::output::paths::Declared;
+use crate::output::paths::{replaceable, Declared};
 use crate::output::{is_stdout, print_stdout, write_json, CliError};
 use crate::plots::{line_chart, Series};
 use crate::run::Run;
@@ -68,6 +68,11 @@ fn file_decimals(values: impl Iterator<Item = f64> + Clone) -> usize {
         .unwrap_or(12)
 }
 
+/// The bench log of the run at precharge `p0` [Pa], its MPa with `decimals`.
+fn log_name(p0: f64, decimals: usize) -> String {
+    format!("precharge-{:.*}MPa.csv", decimals, p0 / 1e6)
+}
+
 /// A sweep result: precharge (None for the reference without absorber), run, figures.
 type SweepPoint = (Option<f64>, Run, Pulsation);
 
@@ -91,6 +96,20 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
                 "--values names the precharge {} Pa twice",
                 show(*v)
             )));
+        }
+    }
+    if let Some(dir) = &args.out {
+        // The folder's files, checked before the runs (see `write_sweep_outputs`).
+        let decimals = file_decimals(args.values.iter().copied());
+        let logs = args.values.iter().map(|p0| log_name(*p0, decimals));
+        for name in logs.chain([
+            "no-absorber.csv".into(),
+            "pressure_traces.svg".into(),
+            "sweep.svg".into(),
+            "pressure_traces.png".into(),
+            "sweep.png".into(),
+        ]) {
+            replaceable("--out", &dir.join(name))?;
         }
     }
     let effects: Vec<Effect> = paper_low_speed_effects().to_vec();
@@ -221,10 +240,7 @@ fn write_sweep_outputs(
         .map(|(p0, _, _)| format!("p0 = {:.1} MPa", p0 / 1e6))
         .collect();
     for ((p0, run, _), name) in points.iter().zip(&names) {
-        write_log(
-            &dir.join(format!("precharge-{:.*}MPa.csv", decimals, p0 / 1e6)),
-            &run.log,
-        )?;
+        write_log(&dir.join(log_name(*p0, decimals)), &run.log)?;
         traces.push(Series {
             name,
             points: window(run),

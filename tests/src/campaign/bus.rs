@@ -423,7 +423,11 @@ mod tests {
 
     #[test]
     fn commands_reach_the_controller_and_garbage_does_not() {
-        let mut c = Controller::new(&Config::nominal());
+        // A drive brought up as the closed-loop runs bring it up (sensor zeros trusted,
+        // encoder referenced, no bootstrap wait): the bring-up rules refuse a running mode
+        // before that.
+        let config = closed_loop::controller_config(&plant_model::Rig::nominal());
+        let mut c = Controller::new(&config);
         let mut bus = Bus::new();
         bus.pc_send(&Request::SetMode(Mode::Speed));
         bus.run_until(1e-3, &mut c);

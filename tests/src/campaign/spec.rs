@@ -12,8 +12,8 @@
 //! | transducer | the reading below the open-wire or above the short level, or a pressure above the over-pressure level | 5 / 6 / 4 | 0 |
 //! | encoder | a count step beyond the plausible speed's, an index far from count 0, a revolution and its margin without an index | 7, 8 | 0 |
 //! | over-speed (truth) | the shaft above the over-speed level by 2 % | 9 | two speed-loop periods |
-//! | current sum | the three phase-current readings sum beyond the plausible level (plus the offsets' tolerance until they are measured) | 18 | 0 |
-//! | stall (truth) | the bridge has driven 90 % of the q-current limit into a shaft turning below a tenth of the speed limit for 90 % of the stall time | 19 | 30 % of the stall time |
+//! | current sum | the three phase-current readings sum beyond the plausible level (plus the offsets' tolerance until they are measured, and while a calibration measures them again) | 19 | 0 |
+//! | stall (truth) | the bridge has driven 90 % of the q-current limit into a shaft turning below a tenth of the speed limit for 90 % of the stall time | 20 | 30 % of the stall time |
 //! | command timeout | no command reached the drive for longer than the timeout, in an active mode | 10 | 2 |
 //! | watchdog | the application reported an overrun | 11 | 1 |
 //!
@@ -212,7 +212,7 @@ impl Spec {
                 .zip(v.offsets_lsb)
                 .map(|(c, o)| (f32::from(*c) - o) * s.current_a_per_lsb)
                 .sum();
-        let allowance = if v.calibrated {
+        let allowance = if v.calibrated && v.mode != Mode::Calibrating {
             0.0
         } else {
             3.0 * self.cfg.calibration.offset_max_lsb * s.current_a_per_lsb

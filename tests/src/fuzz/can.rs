@@ -102,7 +102,7 @@ fn measurements(data: &[u8]) -> (Measurements, &[u8]) {
         adc_pressure: u16_at(8),
         encoder_count: u32::from(u16_at(10)),
         encoder_index: b[12] & 1 == 1,
-        // The capture is the counter itself: the fuzzed bytes stay 13.
+        // The index captured where the counter stands.
         encoder_index_count: u32::from(u16_at(10)),
     };
     (m, &data[n..])

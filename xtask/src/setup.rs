@@ -1,0 +1,118 @@
+//! What `cargo xtask test` needs beyond Rust, installed when missing so the README's one
+//! command works on a fresh machine (Debian or Ubuntu, as root or with sudo-less apt):
+//!
+//! - `qemu-system-arm` (QEMU's Cortex-M4F, `mps2-an386`) for the processor-in-the-loop run;
+//! - `tmux`, the terminal `eha watch`'s screen test runs the live view in;
+//! - Python's `cantools` (pinned in `xtask/requirements.txt`) in a virtual environment under
+//!   the target directory, for the DBC check. `EHA_PYTHON` names an interpreter that has it
+//!   already (`.ci/run` makes one); a missing or broken one is an error, never a skip.
+//!
+//! apt-get runs only when something is missing, after `apt-get update`.
+
+use anyhow::{bail, Context, Result};
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+/// Tools found on `PATH` by name, the argument that makes each print its version and exit
+/// successfully (QEMU refuses tmux's `-V`), and the Debian package that has each.
+const TOOLS: [(&str, &str, &str); 2] = [
+    ("qemu-system-arm", "--version", "qemu-system-arm"),
+    ("tmux", "-V", "tmux"),
+];
+
+fn found(program: &str, arg: &str) -> bool {
+    Command::new(program)
+        .arg(arg)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Installs `packages` with apt-get (after `apt-get update`).
+fn apt_install(packages: &[&str]) -> Result<()> {
+    if !found("apt-get", "--version") {
+        bail!(
+            "{} missing and there is no apt-get to install them with: install them with your \
+             system's package manager",
+            packages.join(", ")
+        );
+    }
+    crate::run("apt-get update", Command::new("apt-get").arg("update"))?;
+    crate::run(
+        "apt-get install",
+        Command::new("apt-get")
+            .args(["install", "-y", "--no-install-recommends"])
+            .args(packages),
+    )
+}
+
+/// Installs the tools of [`TOOLS`] that are missing.
+pub fn tools() -> Result<()> {
+    let missing: Vec<&str> = TOOLS
+        .iter()
+        .filter(|(cmd, version, _)| !found(cmd, version))
+        .map(|(_, _, pkg)| *pkg)
+        .collect();
+    if !missing.is_empty() {
+        apt_install(&missing)?;
+    }
+    Ok(())
+}
+
+fn has_cantools(python: &std::path::Path) -> bool {
+    Command::new(python)
+        .args(["-c", "import cantools"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// A Python interpreter with `cantools`: `EHA_PYTHON`, or the target directory's virtual
+/// environment (made and filled from `xtask/requirements.txt` when missing).
+pub fn python() -> Result<PathBuf> {
+    if let Some(p) = std::env::var_os("EHA_PYTHON") {
+        let p = PathBuf::from(p);
+        if !has_cantools(&p) {
+            bail!(
+                "EHA_PYTHON={} cannot import cantools (pip install -r xtask/requirements.txt)",
+                p.display()
+            );
+        }
+        return Ok(p);
+    }
+    let venv = crate::target_dir().join("py-venv");
+    let python = venv.join("bin").join("python");
+    if has_cantools(&python) {
+        return Ok(python);
+    }
+    let make = || {
+        Command::new("python3")
+            .args(["-m", "venv"])
+            .arg(&venv)
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    if !make() {
+        // Debian splits venv and pip out of python3.
+        apt_install(&["python3", "python3-venv", "python3-pip"])?;
+        if !make() {
+            bail!("python3 -m venv {} failed", venv.display());
+        }
+    }
+    crate::run(
+        "cantools into the check's virtual environment",
+        Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet", "-r"])
+            .arg(crate::root().join("xtask").join("requirements.txt")),
+    )
+    .context("installing cantools with pip")?;
+    if !has_cantools(&python) {
+        bail!(
+            "{} cannot import cantools after pip install",
+            python.display()
+        );
+    }
+    Ok(python)
+}
