@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::RamFlash;
+use common::{power_up, RamFlash};
 use firmware::can_protocol::{
     decode_command, encode_command, encode_set_parameter, NodeId, RejectReason, Reply, Request,
 };
@@ -19,22 +19,6 @@ use firmware::{Command, Config, Controller, FaultCode, Measurements, Mode};
 
 fn node() -> NodeId {
     NodeId::new(1).expect("node")
-}
-
-/// Power-up as on the board: offsets measured at rest, then the encoder index.
-fn power_up(c: &mut Controller) {
-    let at_rest = Measurements {
-        adc_dc_link: 2800,
-        adc_pressure: 6554 + 6291,
-        ..Measurements::default()
-    };
-    for _ in 0..1000 {
-        c.on_current_sample(&at_rest);
-    }
-    c.on_current_sample(&Measurements {
-        encoder_index: true,
-        ..at_rest
-    });
 }
 
 /// A table whose constant channel is a 72/rev line of `amp` A (LSB 2^−19: ±0.0625 A),

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::RamFlash;
+use common::{power_up, RamFlash};
 use firmware::can_protocol::{
     decode_command, decode_reply, encode_command, encode_get_parameter, encode_reply,
     encode_set_parameter, Frame, NodeId, RejectReason, Rejection, Reply, Request,
@@ -15,29 +15,12 @@ use firmware::can_server::{serve, Response};
 use firmware::compensation::record::source;
 use firmware::param_store::{boot, boot_config, BootOutcome, ParamStore};
 use firmware::parameters::{ParamId, COUNT};
-use firmware::{Command, Config, Controller, Measurements, Mode};
+use firmware::{Command, Config, Controller, Mode};
 
 const NODE: u8 = 3;
 
 fn node() -> NodeId {
     NodeId::new(NODE).expect("node")
-}
-
-/// Power-up as on the board: the current offsets measured at rest (0.05 s at 20 kHz: 0 A,
-/// 280 V, 3 MPa), then the encoder index passes (captured at counter 0).
-fn power_up(c: &mut Controller) {
-    let at_rest = Measurements {
-        adc_dc_link: 2800,
-        adc_pressure: 6554 + 6291,
-        ..Measurements::default()
-    };
-    for _ in 0..1000 {
-        c.on_current_sample(&at_rest);
-    }
-    c.on_current_sample(&Measurements {
-        encoder_index: true,
-        ..at_rest
-    });
 }
 
 /// The drive: decodes a frame, serves it, encodes what it answers (None: silent).
