@@ -21,7 +21,7 @@ pub mod config;
 pub mod scenario;
 
 pub use config::controller_config;
-pub use scenario::{by_name, Scenario, ScenarioKind, SCENARIOS};
+pub use scenario::{by_name, Scenario, ScenarioKind, PROCEDURES, SCENARIOS};
 
 use firmware::io::{Measurements, Outputs};
 use firmware::{Command, Controller};

@@ -20,6 +20,8 @@ pub enum ScenarioKind {
     SlowStroke,
     /// The commissioning sequence (motor identification) on the free shaft.
     Commissioning,
+    /// The torque feed-forward's bench sweep: constant speed both ways, payload free.
+    CompensationSweep,
 }
 
 /// A named scenario.
@@ -120,7 +122,43 @@ pub const SCENARIOS: [Scenario; 4] = [
     },
 ];
 
-/// The scenario called `name`.
+/// Speed of the torque feed-forward's bench sweep: 1.6 revolutions per second, so a
+/// steady window of a few seconds holds several revolutions and the cogging's 72nd order
+/// (115 Hz) stays below a third of a 1 kHz log's rate. [rad/s]
+pub const SWEEP_SPEED_RAD_S: f32 = 10.0;
+/// Duration of each of the sweep's two legs. [s]
+pub const SWEEP_LEG_S: f32 = 6.0;
+
+/// The bench procedures the firmware runs itself, beside the [`SCENARIOS`] (kept apart so
+/// the studies over every scenario stay as they were).
+pub const PROCEDURES: [Scenario; 1] = [Scenario {
+    name: "compensation-sweep",
+    description: "the torque feed-forward's bench procedure: the drive's own sweep at 10 rad/s, 6 s each way, payload free at the fill pressure",
+    kind: ScenarioKind::CompensationSweep,
+    blocked: false,
+    initial_pressure_pa: 0.5e6,
+    duration_s: 12.8,
+    steady_from_s: 0.3,
+    events: [
+        Some((0.0, Command::SetSpeed { rad_s: 0.0 })),
+        Some((0.0, Command::SetMode(Mode::Speed))),
+        Some((
+            0.3,
+            Command::CompensationSweep {
+                speed_rad_s: SWEEP_SPEED_RAD_S,
+                leg_s: SWEEP_LEG_S,
+            },
+        )),
+        None,
+        None,
+        None,
+    ],
+}];
+
+/// The scenario or procedure called `name`.
 pub fn by_name(name: &str) -> Option<&'static Scenario> {
-    SCENARIOS.iter().find(|s| s.name == name)
+    SCENARIOS
+        .iter()
+        .chain(PROCEDURES.iter())
+        .find(|s| s.name == name)
 }

@@ -28,12 +28,20 @@
 //! | `0x220` | host → drive | `SaveParameters` | 0 | — (allowed in Disabled only)            |
 //! | `0x230` | host → drive | `StepTest`     | 7   | `u8` loop (1 current, 2 speed, 3 pressure), `f32` amplitude [A, rad/s, Pa], `u16` duration [ms] |
 //! | `0x240` | host → drive | `Commission`   | 0   | — runs the commissioning sequence ([`crate::commissioning`]) in Calibrating |
+//! | `0x250` | host → drive | `CompensationBin` | 8 | `u16` bin, then its three `i16` channel values; bin `0xFFFF` is the table's header: three `i8` LSB exponents, `u8` 0, `u16` bin count |
+//! | `0x260` | host → drive | `CompensationCommit` | 4 | `u32` CRC-32 of the table's record ([`crate::compensation::record`]) |
+//! | `0x270` | host → drive | `CompensationSweep` | 6 | `f32` speed [rad/s], `u16` duration of each leg [ms] ([`crate::sweep`], Speed mode) |
 //!
 //! Mode codes: `0` disabled, `1` calibrating, `2` speed control, `3` pressure control.
 //!
-//! The configuration and test commands (`0x200`‥`0x230`) sit above the replies on purpose:
-//! set-points, mode changes and the drive's status win arbitration over them. Their ids
-//! `0x250`‥`0x270` are free for further configuration commands. Parameter ids, names,
+//! The configuration and test commands (`0x200`‥`0x270`) sit above the replies on purpose:
+//! set-points, mode changes and the drive's status win arbitration over them. The torque
+//! feed-forward's table ([`crate::compensation`]) loads as a header, its 512 bins in order
+//! and a commit carrying the record's CRC (a lost or repeated frame fails the commit; the
+//! feed-forward is off from the header to an accepted commit); each accepted frame is
+//! acknowledged by a status. A refused commit names the bound it broke: reason `2` with
+//! `compensation.max_current_a` [A] for an amplitude over the limit, reason `7` with the
+//! expected bin (out-of-order bin) or `0` (CRC) otherwise. Parameter ids, names,
 //! units and bounds are the table of [`crate::parameters`]; values are IEEE-754 `f32`
 //! (little endian) in SI units, so a value read back is bit-identical to the one set.
 //! `SetParameter` is answered with a `Parameter` frame echoing the value now in use,
@@ -100,6 +108,8 @@
 //! | 1‥4   | `f32` | value in use, in the parameter's unit                            |
 //! | 5‥7   | —     | reserved, `0`                                                    |
 
+use crate::compensation::record::RecordError;
+use crate::compensation::CompensationError;
 use crate::controller::{Command, CommandError};
 use crate::parameters::{ParamError, ParamId};
 use crate::step_test::{StepLoop, StepTestError};
@@ -154,7 +164,16 @@ pub mod id {
     pub const STEP_TEST: u16 = 0x230;
     /// `Commission` command.
     pub const COMMISSION: u16 = 0x240;
+    /// `CompensationBin` command (and the table's header).
+    pub const COMPENSATION_BIN: u16 = 0x250;
+    /// `CompensationCommit` command.
+    pub const COMPENSATION_COMMIT: u16 = 0x260;
+    /// `CompensationSweep` command.
+    pub const COMPENSATION_SWEEP: u16 = 0x270;
 }
+
+/// The bin number of a `CompensationBin` frame that carries the table's header.
+pub const COMPENSATION_HEADER_BIN: u16 = 0xFFFF;
 
 /// Mask selecting the node number of an identifier.
 const NODE_MASK: u16 = 0x00F;
@@ -257,11 +276,17 @@ pub enum Function {
     StepTest,
     /// `Commission`, code `0x24`.
     Commission,
+    /// `CompensationBin`, code `0x25`.
+    CompensationBin,
+    /// `CompensationCommit`, code `0x26`.
+    CompensationCommit,
+    /// `CompensationSweep`, code `0x27`.
+    CompensationSweep,
 }
 
 impl Function {
     /// Every command, in identifier order.
-    pub const ALL: [Function; 10] = [
+    pub const ALL: [Function; 13] = [
         Function::SetMode,
         Function::SetPressure,
         Function::SetSpeed,
@@ -272,6 +297,9 @@ impl Function {
         Function::SaveParameters,
         Function::StepTest,
         Function::Commission,
+        Function::CompensationBin,
+        Function::CompensationCommit,
+        Function::CompensationSweep,
     ];
 
     /// Identifier base of the command.
@@ -287,6 +315,9 @@ impl Function {
             Function::SaveParameters => id::SAVE_PARAMETERS,
             Function::StepTest => id::STEP_TEST,
             Function::Commission => id::COMMISSION,
+            Function::CompensationBin => id::COMPENSATION_BIN,
+            Function::CompensationCommit => id::COMPENSATION_COMMIT,
+            Function::CompensationSweep => id::COMPENSATION_SWEEP,
         }
     }
 
@@ -313,6 +344,9 @@ impl Function {
             id::SAVE_PARAMETERS => Some(Function::SaveParameters),
             id::STEP_TEST => Some(Function::StepTest),
             id::COMMISSION => Some(Function::Commission),
+            id::COMPENSATION_BIN => Some(Function::CompensationBin),
+            id::COMPENSATION_COMMIT => Some(Function::CompensationCommit),
+            id::COMPENSATION_SWEEP => Some(Function::CompensationSweep),
             _ => None,
         }
     }
@@ -324,6 +358,9 @@ impl Function {
             Function::SetPressure | Function::SetSpeed => 4,
             Function::SetParameter => 5,
             Function::StepTest => 7,
+            Function::CompensationBin => 8,
+            Function::CompensationCommit => 4,
+            Function::CompensationSweep => 6,
             Function::ClearFaults
             | Function::Heartbeat
             | Function::SaveParameters
@@ -377,6 +414,32 @@ pub enum Request {
     },
     /// Run the commissioning sequence (motor identification and gain design).
     Commission,
+    /// Start loading the torque feed-forward's table.
+    CompensationHeader {
+        /// LSB exponent per channel. [1]
+        exponents: [i8; 3],
+        /// Bins per revolution.
+        bins: u16,
+    },
+    /// One bin of the table being loaded.
+    CompensationBin {
+        /// Bin index (below [`COMPENSATION_HEADER_BIN`]).
+        bin: u16,
+        /// The three channels' raw values.
+        raw: [i16; 3],
+    },
+    /// Commit the loaded table.
+    CompensationCommit {
+        /// CRC-32 of the table's record.
+        crc: u32,
+    },
+    /// Run the feed-forward's bench sweep.
+    CompensationSweep {
+        /// Speed of the first leg. [rad/s]
+        speed_rad_s: f32,
+        /// Duration of each leg. [ms]
+        leg_ms: u16,
+    },
 }
 
 impl Request {
@@ -407,6 +470,11 @@ impl Request {
             Request::SaveParameters => Function::SaveParameters,
             Request::StepTest { .. } => Function::StepTest,
             Request::Commission => Function::Commission,
+            Request::CompensationHeader { .. } | Request::CompensationBin { .. } => {
+                Function::CompensationBin
+            }
+            Request::CompensationCommit { .. } => Function::CompensationCommit,
+            Request::CompensationSweep { .. } => Function::CompensationSweep,
         }
     }
 
@@ -443,6 +511,18 @@ impl Request {
                 duration_s: f32::from(duration_ms) * 1e-3,
             },
             Request::Commission => Command::Commission,
+            Request::CompensationHeader { exponents, bins } => {
+                Command::CompensationHeader { exponents, bins }
+            }
+            Request::CompensationBin { bin, raw } => Command::CompensationBin { bin, raw },
+            Request::CompensationCommit { crc } => Command::CompensationCommit { crc },
+            Request::CompensationSweep {
+                speed_rad_s,
+                leg_ms,
+            } => Command::CompensationSweep {
+                speed_rad_s,
+                leg_s: f32::from(leg_ms) * 1e-3,
+            },
             Request::GetParameter { .. } | Request::SaveParameters => return None,
         })
     }
@@ -625,8 +705,12 @@ impl Rejection {
                     StepTestError::BelowMinimum { min } => (RejectReason::BelowMinimum, min),
                     StepTestError::AboveMaximum { max } => (RejectReason::AboveMaximum, max),
                     StepTestError::Duration { bound_s } => {
-                        let below = matches!(request, Request::StepTest { duration_ms, .. }
-                            if f32::from(*duration_ms) * 1e-3 < bound_s);
+                        let asked_ms = match request {
+                            Request::StepTest { duration_ms, .. } => *duration_ms,
+                            Request::CompensationSweep { leg_ms, .. } => *leg_ms,
+                            _ => 0,
+                        };
+                        let below = f32::from(asked_ms) * 1e-3 < bound_s;
                         let reason = if below {
                             RejectReason::BelowMinimum
                         } else {
@@ -635,7 +719,10 @@ impl Rejection {
                         (reason, bound_s)
                     }
                 };
-                return Rejection::with_si_bound(Function::StepTest, reason, bound, 0);
+                return Rejection::with_si_bound(request.function(), reason, bound, 0);
+            }
+            CommandError::Compensation(e) => {
+                return Rejection::for_compensation_error(request.function(), &e)
             }
         };
         Rejection {
@@ -662,6 +749,35 @@ impl Rejection {
         Rejection::with_si_bound(Function::SetParameter, reason, bound, err.id().code())
     }
 
+    /// The reply for a refused feed-forward table frame: an amplitude over the limit names
+    /// the limit [A] (reason `AboveMaximum`), an out-of-order bin the bin expected, an
+    /// incomplete load the bins received (reason `Invalid`), a bin or commit without a
+    /// header reason `NotAllowed`, a bad CRC or exponent reason `Invalid` with bound 0 or
+    /// the largest exponent.
+    pub fn for_compensation_error(function: Function, err: &CompensationError) -> Rejection {
+        let (reason, bound) = match *err {
+            CompensationError::Amplitude { limit_a, .. } => (RejectReason::AboveMaximum, limit_a),
+            CompensationError::Record(r) => match r {
+                RecordError::OutOfOrder { expected } => {
+                    (RejectReason::Invalid, f32::from(expected))
+                }
+                RecordError::Incomplete { received } => {
+                    (RejectReason::Invalid, f32::from(received))
+                }
+                RecordError::NotLoading => (RejectReason::NotAllowed, 0.0),
+                RecordError::Exponent { .. } => (
+                    RejectReason::AboveMaximum,
+                    f32::from(crate::compensation::MAX_EXPONENT),
+                ),
+                RecordError::Bins { .. } => {
+                    (RejectReason::Invalid, crate::compensation::BINS as f32)
+                }
+                _ => (RejectReason::Invalid, 0.0),
+            },
+        };
+        Rejection::with_si_bound(function, reason, bound, 0)
+    }
+
     /// A refusal of a configuration or test function, with an SI bound.
     pub fn with_si_bound(
         function: Function,
@@ -679,17 +795,10 @@ impl Rejection {
     }
 
     /// The bound in SI units for the configuration and test functions (codes
-    /// `0x20`‥`0x23`), whose bound field is an `f32`; `None` for the others.
+    /// `0x20`‥`0x27`), whose bound field is an `f32`; `None` for the others.
     pub fn si_bound(&self) -> Option<f32> {
-        let configuration = matches!(
-            Function::from_code(self.function),
-            Some(
-                Function::SetParameter
-                    | Function::GetParameter
-                    | Function::SaveParameters
-                    | Function::StepTest,
-            )
-        );
+        let configuration = Function::from_code(self.function)
+            .is_some_and(|f| f.id_base() >= id::SET_PARAMETER && f != Function::Commission);
         let si_reason = matches!(
             self.reason,
             RejectReason::BelowMinimum
@@ -886,6 +995,33 @@ pub fn decode_command(frame: &Frame, node: NodeId) -> Result<Request, DecodeErro
         }),
         Function::SaveParameters => Ok(Request::SaveParameters),
         Function::Commission => Ok(Request::Commission),
+        Function::CompensationBin => {
+            // The length was checked: the frame's whole data array is the payload.
+            let d = &frame.data;
+            let bin = u16::from_le_bytes([d[0], d[1]]);
+            if bin == COMPENSATION_HEADER_BIN {
+                Ok(Request::CompensationHeader {
+                    exponents: [d[2] as i8, d[3] as i8, d[4] as i8],
+                    bins: u16::from_le_bytes([d[6], d[7]]),
+                })
+            } else {
+                Ok(Request::CompensationBin {
+                    bin,
+                    raw: [
+                        i16::from_le_bytes([d[2], d[3]]),
+                        i16::from_le_bytes([d[4], d[5]]),
+                        i16::from_le_bytes([d[6], d[7]]),
+                    ],
+                })
+            }
+        }
+        Function::CompensationCommit => Ok(Request::CompensationCommit {
+            crc: read_i32(payload, 0) as u32,
+        }),
+        Function::CompensationSweep => Ok(Request::CompensationSweep {
+            speed_rad_s: read_f32(payload, 0),
+            leg_ms: u16::from_le_bytes([frame.data[4], frame.data[5]]),
+        }),
         Function::StepTest => {
             let code = payload.first().copied().unwrap_or(0);
             let target =
@@ -940,6 +1076,27 @@ pub fn encode_command(request: &Request, node: NodeId) -> Frame {
             data[0] = target.code();
             write_f32(&mut data, 1, amplitude);
             data[5..7].copy_from_slice(&duration_ms.to_le_bytes());
+        }
+        Request::CompensationHeader { exponents, bins } => {
+            data[0..2].copy_from_slice(&COMPENSATION_HEADER_BIN.to_le_bytes());
+            for (c, e) in exponents.iter().enumerate() {
+                data[2 + c] = *e as u8;
+            }
+            data[6..8].copy_from_slice(&bins.to_le_bytes());
+        }
+        Request::CompensationBin { bin, raw } => {
+            data[0..2].copy_from_slice(&bin.to_le_bytes());
+            for (c, v) in raw.iter().enumerate() {
+                data[2 + 2 * c..4 + 2 * c].copy_from_slice(&v.to_le_bytes());
+            }
+        }
+        Request::CompensationCommit { crc } => write_i32(&mut data, 0, crc as i32),
+        Request::CompensationSweep {
+            speed_rad_s,
+            leg_ms,
+        } => {
+            write_f32(&mut data, 0, speed_rad_s);
+            data[4..6].copy_from_slice(&leg_ms.to_le_bytes());
         }
         Request::ClearFaults
         | Request::Heartbeat

@@ -8,6 +8,7 @@
 //! constants from a validated `Config` and never mutates it.
 
 pub use crate::commissioning::CommissioningConfig;
+pub use crate::compensation::CompensationConfig;
 use core::fmt;
 
 /// Sample rates of the three loops.
@@ -244,6 +245,8 @@ pub struct Config {
     pub calibration: CalibrationConfig,
     /// Commissioning sequence (motor identification, issue 8).
     pub commissioning: CommissioningConfig,
+    /// Angle-indexed torque feed-forward ([`crate::compensation`]).
+    pub compensation: CompensationConfig,
 }
 
 /// A configuration field that failed validation.
@@ -387,6 +390,7 @@ impl Config {
                 alignment_time_s: 0.5,
             },
             commissioning: CommissioningConfig::nominal(),
+            compensation: CompensationConfig::nominal(),
         }
     }
 
@@ -669,7 +673,8 @@ impl Config {
             c.voltage_limit_v,
             sp.speed_limit_rad_s,
             r.pwm_hz,
-        )
+        )?;
+        self.compensation.validate()
     }
 }
 

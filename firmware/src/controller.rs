@@ -28,6 +28,7 @@
 //! uses the last commanded speed setpoint (0 if none).
 
 use crate::commissioning::{Commissioning, CommissioningResult};
+use crate::compensation::{Compensation, CompensationError, Exponent, CHANNELS};
 use crate::config::{whole_ratio, Config};
 use crate::current_loop::{CurrentLoop, CurrentLoopState};
 use crate::encoder::{max_step_counts, Encoder, EncoderEvent};
@@ -40,6 +41,7 @@ use crate::speed_loop::SpeedLoop;
 use crate::speed_observer::SpeedObserver;
 use crate::step_test::{self, ActiveStep, StepLoop, StepTestError};
 use crate::supervisor::{Conditions, FaultCode, Mode, ModeRefusal, Readiness, Supervisor};
+use crate::sweep::Sweep;
 use crate::telemetry::TelemetryFrame;
 use crate::transforms::Dq;
 use calibrate::{Calibration, OffsetAverage};
@@ -85,6 +87,35 @@ pub enum Command {
         /// How long the step is held. [s]
         duration_s: f32,
     },
+    /// Starts loading the torque feed-forward's table ([`crate::compensation`]): the
+    /// feed-forward is off until the commit.
+    CompensationHeader {
+        /// LSB exponent e per channel (values are i16 · 2^−e). [1]
+        exponents: [Exponent; CHANNELS],
+        /// Bins per revolution of the table sent (must be [`crate::compensation::BINS`]).
+        bins: u16,
+    },
+    /// The next bin of the table being loaded (in order from 0).
+    CompensationBin {
+        /// Bin index.
+        bin: u16,
+        /// The three channels' raw values.
+        raw: [i16; CHANNELS],
+    },
+    /// Ends a table load: the CRC of the record the bins make; the table is checked
+    /// against the amplitude limit and takes effect.
+    CompensationCommit {
+        /// CRC-32 of the table's record ([`crate::compensation::record`]).
+        crc: u32,
+    },
+    /// The feed-forward's bench procedure ([`crate::sweep`]): a constant-speed sweep in
+    /// both directions, in Speed mode.
+    CompensationSweep {
+        /// Speed of the first leg. [rad/s]
+        speed_rad_s: f32,
+        /// Duration of each leg. [s]
+        leg_s: f32,
+    },
 }
 
 /// Why a command was refused. Its [`CommandError::code`] shows in telemetry.
@@ -110,8 +141,10 @@ pub enum CommandError {
     CausePresent(FaultCode),
     /// Parameter value refused.
     Parameter(ParamError),
-    /// Step test refused.
+    /// Step test (or feed-forward sweep) refused.
     StepTest(StepTestError),
+    /// Feed-forward table refused.
+    Compensation(CompensationError),
 }
 
 impl CommandError {
@@ -127,6 +160,7 @@ impl CommandError {
             CommandError::CausePresent(_) => 6,
             CommandError::Parameter(_) => 7,
             CommandError::StepTest(_) => 8,
+            CommandError::Compensation(_) => 10,
         }
     }
 }
@@ -168,6 +202,7 @@ impl fmt::Display for CommandError {
             CommandError::StepTest(StepTestError::Duration { bound_s }) => {
                 write!(f, "step test refused: duration beyond {bound_s} s")
             }
+            CommandError::Compensation(e) => write!(f, "{e}"),
         }
     }
 }
@@ -228,6 +263,12 @@ pub struct Controller {
     /// The current loop runs at a forced angle this period (no speed decoupling).
     forced_frame: bool,
     step: Option<ActiveStep>,
+    /// The torque feed-forward (table, gain, lead).
+    compensation: Compensation,
+    /// The feed-forward's q current this period. [A]
+    iq_ff: f32,
+    /// The feed-forward's bench sweep, while it runs.
+    sweep: Option<Sweep>,
     stall: StallMonitor,
 }
 
@@ -304,6 +345,9 @@ impl Controller {
             commission_speed_on: false,
             forced_frame: false,
             step: None,
+            compensation: Compensation::new(config),
+            iq_ff: 0.0,
+            sweep: None,
             stall: StallMonitor::new(config.limits.stall_time_s, pwm),
         }
     }
@@ -502,6 +546,15 @@ impl Controller {
                 self.speed_ref = self.pressure.step(mean);
             }
         }
+        if let Some(sweep) = &mut self.sweep {
+            match (mode, sweep.advance()) {
+                (Mode::Speed, Some(w)) => self.speed_setpoint = w,
+                _ => {
+                    self.speed_setpoint = 0.0;
+                    self.sweep = None;
+                }
+            }
+        }
         // Speed loop tick.
         self.speed_tick += 1;
         if self.speed_tick >= self.d.speed_div {
@@ -529,8 +582,17 @@ impl Controller {
         // Current references by mode; calibration may hold the bridge off or force θ_e.
         let mut bridge = mode.is_active();
         let mut conditions = Conditions::default();
+        self.iq_ff = 0.0;
         match mode {
-            Mode::Speed | Mode::Pressure => self.id_ref = 0.0,
+            Mode::Speed | Mode::Pressure => {
+                self.id_ref = 0.0;
+                self.iq_ff = self.compensation.current(
+                    self.theta_m,
+                    self.speed.speed(),
+                    self.p_pa,
+                    self.iq_ref,
+                );
+            }
             Mode::Calibrating => {
                 let (on, theta, fault) = self.calibrate(m);
                 bridge = on;
@@ -560,7 +622,7 @@ impl Controller {
         self.state = if bridge && !precharging {
             let i_ref = Dq {
                 d: self.id_ref,
-                q: self.iq_ref,
+                q: self.iq_ref + self.iq_ff,
             };
             match self.open_loop_voltage.take() {
                 Some(u) => self.current.apply_voltage(m, theta_e, u),
@@ -700,9 +762,10 @@ impl Controller {
             c,
             Command::SetPressure { .. } | Command::SetSpeed { .. } | Command::SetMode(_)
         ) {
-            // A new setpoint or mode supersedes a running step test; the new value wins,
-            // so the test ends without restoring its base.
+            // A new setpoint or mode supersedes a running step test or sweep; the new
+            // value wins, so the test ends without restoring its base.
             self.step = None;
+            self.sweep = None;
         }
         match c {
             Command::Heartbeat => Ok(()),
@@ -710,11 +773,21 @@ impl Controller {
                 if id.needs_disabled() && self.sup.mode() != Mode::Disabled {
                     return Err(CommandError::Parameter(ParamError::NotWhileRunning { id }));
                 }
-                id.set(&mut self.cfg, value)
+                let mut next = self.cfg;
+                id.set(&mut next, value).map_err(CommandError::Parameter)?;
+                self.check_compensation_parameter(id, &next)
                     .map_err(CommandError::Parameter)?;
+                self.cfg = next;
+                if id == ParamId::CompensationClear && value == 1.0 {
+                    self.compensation.clear(&self.cfg);
+                }
                 self.retune(id);
                 Ok(())
             }
+            Command::CompensationHeader { .. }
+            | Command::CompensationBin { .. }
+            | Command::CompensationCommit { .. }
+            | Command::CompensationSweep { .. } => self.apply_compensation(c),
             Command::StepTest {
                 target,
                 amplitude,
@@ -787,6 +860,7 @@ impl Controller {
         self.observer
             .set_bandwidth(self.cfg.speed.observer_bandwidth_rad_s);
         self.pressure.retune(&self.cfg);
+        self.compensation.retune(&self.cfg);
         if id == ParamId::EncoderOffset {
             self.encoder.set_offset(self.cfg.sensors.encoder_offset_rad);
         }
@@ -900,7 +974,7 @@ impl Controller {
             id_a: self.state.i_dq.d,
             theta_m_rad: self.theta_m,
             speed_ref_rad_s: self.speed_ref,
-            iq_ref_a: self.iq_ref,
+            iq_ref_a: self.iq_ref + self.iq_ff,
             ud_v: self.state.u_dq.d,
             uq_v: self.state.u_dq.q,
             udc_v: self.state.u_dc,
@@ -913,5 +987,6 @@ impl Controller {
 
 mod calibrate;
 mod commission;
+mod compensate;
 #[cfg(test)]
 mod tests;

@@ -11,13 +11,15 @@
 //! `u_q,ff = ω_e·(L_d·i_d + ψ_f)` before the limits, so the PIs see the bare R-L of the
 //! design; without it the back-EMF is a disturbance the integrators reject.
 //!
-//! Budget: one sin/cos pair (micromath), about 60 floating-point operations; no division
-//! except one by the DC link, which is guarded.
+//! Budget: one sin/cos pair (an interpolated table, [`crate::transforms::sin_cos`]), about
+//! 60 floating-point operations; no division except one by the DC link, which is guarded,
+//! and no clamp of the duties on the modulator's common path
+//! ([`crate::svpwm::modulate_finite`]: the PIs' outputs are finite by construction).
 
 use crate::io::Measurements;
 use crate::pi::Pi;
 use crate::shunt::{max_sampled_duty, SamplingWindow};
-use crate::svpwm::modulate_sampled;
+use crate::svpwm::modulate_finite;
 use crate::transforms::{clarke, inverse_park, park, sin_cos, Dq, SinCos};
 
 /// Everything the current-loop step measured and commanded.
@@ -157,7 +159,13 @@ impl CurrentLoop {
     /// Open-loop voltage: modulates `u_dq` [V] at `theta_e` [rad] without the PIs (their
     /// integrators keep their state for the return to closed loop). Commissioning's
     /// inductance pulses use it, where the voltage must be known exactly.
+    /// A non-finite voltage is zero.
     pub fn apply_voltage(&mut self, m: &Measurements, theta_e: f32, u_dq: Dq) -> CurrentLoopState {
+        let u_dq = if u_dq.d.is_finite() && u_dq.q.is_finite() {
+            u_dq
+        } else {
+            Dq::default()
+        };
         let (state, sc) = self.measure(m, theta_e);
         self.with_voltage(state, sc, u_dq)
     }
@@ -189,8 +197,9 @@ impl CurrentLoop {
         self.with_voltage(state, sc, u_dq)
     }
 
-    /// `state` commanding `u_dq` [V] at the angle of `sc`: the voltage and its duties, the
-    /// middle one kept in its shunt's window; the duties are recorded for the next sample.
+    /// `state` commanding the finite `u_dq` [V] at the angle of `sc`: the voltage and its
+    /// duties, the middle one kept in its shunt's window; the duties are recorded for the
+    /// next sample.
     #[inline]
     fn with_voltage(
         &mut self,
@@ -199,7 +208,11 @@ impl CurrentLoop {
         u_dq: Dq,
     ) -> CurrentLoopState {
         state.u_dq = u_dq;
-        let m = modulate_sampled(inverse_park(u_dq, sc), state.u_dc, self.window.max_duty());
+        let m = modulate_finite(
+            inverse_park(u_dq, sc),
+            state.u_dc,
+            self.window.duty_window(),
+        );
         state.duties = m.duties;
         self.window.record(m.above_window);
         state
@@ -233,7 +246,7 @@ mod tests {
             -10.0 * libm::sinf(th + tau3),
         ];
         let s = cl.step(&adc_for(i), th, Dq { d: 0.0, q: 10.0 }, 0.0);
-        // Within the ADC's LSB (0.024 A) and micromath's 0.2 %.
+        // Within the ADC's LSB (0.024 A).
         assert!((s.i_dq.q - 10.0).abs() < 0.06, "{:?}", s.i_dq);
         assert!(s.i_dq.d.abs() < 0.06, "{:?}", s.i_dq);
         assert!((s.u_dc - 280.0).abs() < 1e-3);

@@ -12,9 +12,11 @@
 //! [`pressure_loop::PressureLoop::step`]) are public for instruction-count benchmarks.
 #![cfg_attr(not(test), no_std)]
 
+pub mod angle_grid;
 pub mod can_protocol;
 pub mod can_server;
 pub mod commissioning;
+pub mod compensation;
 pub mod config;
 pub mod controller;
 pub mod current_loop;
@@ -32,6 +34,7 @@ pub mod speed_observer;
 pub mod step_test;
 pub mod supervisor;
 pub mod svpwm;
+pub mod sweep;
 pub mod telemetry;
 pub mod transforms;
 

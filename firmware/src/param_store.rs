@@ -1,10 +1,10 @@
-//! Persistence of the live parameter table ([`crate::parameters`]) in NOR flash: two
-//! slots used alternately (A/B), each a whole number of erase pages holding at most one
-//! record with a format version, a table fingerprint, a sequence number and a CRC-32,
-//! completed by a separate commit word written last. The slot length is the caller's
-//! (the board's named constant): one 2 KiB page of the G474's bank 2 holds today's record,
-//! and a larger record (a compensation table) takes more pages per slot without any other
-//! change here.
+//! Persistence of the live parameter table ([`crate::parameters`]) and the torque
+//! feed-forward's table ([`crate::compensation`]) in NOR flash: two slots used alternately
+//! (A/B), each a whole number of erase pages holding at most one record with a format
+//! version, a table fingerprint, a sequence number and a CRC-32, followed by the
+//! feed-forward table's own record (version, sizes, CRC: [`crate::compensation::record`])
+//! and completed by a separate commit word written last. The slot length is the caller's
+//! (the board's named constant): two 2 KiB pages of the G474's bank 2 hold the record.
 //!
 //! Generic over [`embedded_storage::nor_flash::NorFlash`], so the same code runs on the
 //! G474's flash and on a RAM-backed flash in the host tests.
@@ -15,11 +15,16 @@
 //! so the previous table stays intact until the new one is complete: a power cut at any
 //! point of a save (during the erase, the record, or the commit word; mid-word included)
 //! leaves the old record readable, and the next load returns the old table or the new one,
-//! never a mixture. A record counts only when its CRC matches *and* its commit word is
-//! present; the commit word is written after the record, so a record interrupted after
-//! its last data word but before the commit is not taken either. The sequence number
-//! (newer = larger, counted with wrap-around) decides between two valid slots. Two slots
-//! cost twice the record's pages of flash; a log-structured store (e.g. `sequential-storage`) would level wear, but the
+//! never a mixture — the parameters and the feed-forward table are saved and committed
+//! together. A record counts only when its CRC matches *and* its commit word is present;
+//! the commit word is written after both records, so a save interrupted after their last
+//! data word but before the commit is not taken either. The feed-forward table of the
+//! record loaded is checked on its own ([`ParamStore::read_table`] feeds
+//! [`crate::Controller::load_compensation_record`]): a wrong size, version or CRC refuses
+//! the table alone (fault 21), the parameters still load. The sequence number
+//! (newer = larger, counted with wrap-around) decides between two valid slots. Two slots cost
+//! twice the record's pages of flash; a log-structured store (e.g. `sequential-storage`) would
+//! level wear, but the
 //! table is saved by an operator, a few times in a drive's life, far below the 10 000
 //! erase cycles of the G4's flash, and the A/B scheme is a fraction of the code size.
 //!
@@ -35,10 +40,11 @@
 //! | 16     | 4·N  | values, `f32`, in [`crate::parameters::ParamId::ALL`] order  |
 //! | 16+4N  | 4    | CRC-32 (ISO-HDLC) of bytes 0‥16+4N                           |
 //! | …      |      | `0xFF` padding to a multiple of 8 bytes                      |
-//! | R      | 8    | commit word: `0x544D_4D43` (`C M M T`), then the sequence number |
+//! | R      | T    | the feed-forward table's record ([`crate::compensation::record`]) |
+//! | R+T    | 8    | commit word: `0x544D_4D43` (`C M M T`), then the sequence number |
 //!
-//! with R = [`RECORD_LEN`]. Both the record and the commit word are multiples of 8 bytes,
-//! the G4's programming unit (one double word with ECC).
+//! with R = [`RECORD_LEN`], T = [`TABLE_LEN`]. The records and the commit word are
+//! multiples of 8 bytes, the G4's programming unit (one double word with ECC).
 //!
 //! # Loading
 //!
@@ -49,6 +55,7 @@
 //! a record whose values are out of their bounds or inconsistent, so the controller never
 //! starts from garbage.
 
+use crate::compensation::record::{self as table_record, CHUNK_MAX};
 use crate::config::Config;
 use crate::parameters::{self, COUNT};
 use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
@@ -58,8 +65,9 @@ use embedded_storage::nor_flash::NorFlash;
 /// flash; a record is checked once per boot and save).
 pub const CRC: Crc<u32, NoTable> = Crc::<u32, NoTable>::new(&CRC_32_ISO_HDLC);
 
-/// Format version of the record; a record of another version is not loaded.
-pub const FORMAT_VERSION: u16 = 1;
+/// Format version of the record; a record of another version is not loaded (version 2:
+/// the feed-forward table between the record and the commit word).
+pub const FORMAT_VERSION: u16 = 2;
 /// Record magic (`E H A P` in memory order).
 pub const MAGIC: u32 = 0x5041_4845;
 /// Commit-word magic (`C M M T` in memory order).
@@ -69,10 +77,16 @@ const HEADER_LEN: usize = 16;
 const CRC_AT: usize = HEADER_LEN + 4 * COUNT;
 /// Length of the record with its padding, before the commit word. [bytes]
 pub const RECORD_LEN: usize = (CRC_AT + 4).div_ceil(8) * 8;
+/// Where the feed-forward table's record starts. [bytes]
+pub const TABLE_AT: usize = RECORD_LEN;
+/// Length of the feed-forward table's record. [bytes]
+pub const TABLE_LEN: usize = table_record::RECORD_LEN;
+/// Where the commit word starts. [bytes]
+pub const COMMIT_AT: usize = TABLE_AT + TABLE_LEN;
 /// Length of the commit word. [bytes]
 pub const COMMIT_LEN: usize = 8;
-/// Bytes a record occupies in its page. [bytes]
-pub const SPAN: usize = RECORD_LEN + COMMIT_LEN;
+/// Bytes a record occupies in its slot. [bytes]
+pub const SPAN: usize = COMMIT_AT + COMMIT_LEN;
 
 /// What a page holds.
 #[derive(Clone, Copy, Debug)]
@@ -120,6 +134,8 @@ pub struct ParamStore<F> {
     flash: F,
     pages: [u32; 2],
     slot_len: u32,
+    /// The slot the last [`ParamStore::load`] took its record from.
+    loaded: Option<u32>,
 }
 
 impl<F: NorFlash> ParamStore<F> {
@@ -153,6 +169,7 @@ impl<F: NorFlash> ParamStore<F> {
             flash,
             pages: [slot_a, slot_b],
             slot_len,
+            loaded: None,
         })
     }
 
@@ -162,17 +179,25 @@ impl<F: NorFlash> ParamStore<F> {
     }
 
     fn read_page(&mut self, page: u32) -> Page {
-        let mut buf = [0u8; SPAN];
-        if self.flash.read(page, &mut buf).is_err() {
+        let mut record = [0u8; RECORD_LEN];
+        let mut commit = [0u8; COMMIT_LEN];
+        if self.flash.read(page, &mut record).is_err()
+            || self
+                .flash
+                .read(page + COMMIT_AT as u32, &mut commit)
+                .is_err()
+        {
             return Page::Corrupt;
         }
-        parse(&buf)
+        parse(&record, &commit)
     }
 
     /// The newest valid table, if any, and what the pages held.
     pub fn load(&mut self) -> (Option<[f32; COUNT]>, LoadOutcome) {
         let pages = self.pages.map(|p| self.read_page(p));
-        match newest(&pages) {
+        let found = newest(&pages);
+        self.loaded = found.and_then(|(i, _, _)| self.pages.get(i).copied());
+        match found {
             Some((_, sequence, values)) => (Some(values), LoadOutcome::Loaded { sequence }),
             // `matches!`, not `==`: a derived comparison of the value arrays costs flash.
             None if pages.iter().all(|p| matches!(p, Page::Blank)) => (None, LoadOutcome::Blank),
@@ -183,10 +208,26 @@ impl<F: NorFlash> ParamStore<F> {
         }
     }
 
-    /// Saves `values` (in [`parameters::ParamId::ALL`] order) as the newest record: erases
-    /// the page not holding the newest valid record, writes the record, then the commit
+    /// Reads `buf.len()` bytes at offset `at` of the feed-forward table's record in the
+    /// slot the last [`ParamStore::load`] took (false: none loaded, or the flash failed).
+    pub fn read_table(&mut self, at: usize, buf: &mut [u8]) -> bool {
+        let Some(page) = self.loaded else {
+            return false;
+        };
+        at + buf.len() <= TABLE_LEN && self.flash.read(page + (TABLE_AT + at) as u32, buf).is_ok()
+    }
+
+    /// Saves `values` (in [`parameters::ParamId::ALL`] order) and the feed-forward table
+    /// whose record `table` produces chunk by chunk (it fills the buffer and returns the
+    /// chunk's offset in the record and length, `None` after the last;
+    /// [`crate::compensation::record::source`]) as the newest record: erases the slot not
+    /// holding the newest valid record, writes the record, the table, then the commit
     /// word. Returns the new record's sequence number.
-    pub fn save(&mut self, values: &[f32; COUNT]) -> Result<u32, StoreError<F::Error>> {
+    pub fn save(
+        &mut self,
+        values: &[f32; COUNT],
+        mut table: impl FnMut(&mut [u8; CHUNK_MAX]) -> Option<(usize, usize)>,
+    ) -> Result<u32, StoreError<F::Error>> {
         let pages = self.pages.map(|p| self.read_page(p));
         let [a, b] = self.pages;
         let (page, sequence) = match newest(&pages) {
@@ -202,8 +243,18 @@ impl<F: NorFlash> ParamStore<F> {
             .erase(page, page + self.slot_len)
             .map_err(StoreError::Flash)?;
         self.flash.write(page, &record).map_err(StoreError::Flash)?;
+        let mut chunk = [0u8; CHUNK_MAX];
+        while let Some((at, len)) = table(&mut chunk) {
+            let bytes = chunk.get(..len).ok_or(StoreError::Layout)?;
+            if at + len > TABLE_LEN {
+                return Err(StoreError::Layout);
+            }
+            self.flash
+                .write(page + (TABLE_AT + at) as u32, bytes)
+                .map_err(StoreError::Flash)?;
+        }
         self.flash
-            .write(page + RECORD_LEN as u32, &commit)
+            .write(page + COMMIT_AT as u32, &commit)
             .map_err(StoreError::Flash)?;
         Ok(sequence)
     }
@@ -253,8 +304,8 @@ fn u32_at(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(w)
 }
 
-/// Classifies a page's first [`SPAN`] bytes.
-fn parse(b: &[u8; SPAN]) -> Page {
+/// Classifies a slot from its parameter record and its commit word.
+fn parse(b: &[u8; RECORD_LEN], commit: &[u8; COMMIT_LEN]) -> Page {
     if b[..HEADER_LEN].iter().all(|x| *x == 0xFF) {
         return Page::Blank;
     }
@@ -271,8 +322,8 @@ fn parse(b: &[u8; SPAN]) -> Page {
     }
     let sequence = u32_at(b, 8);
     if CRC.checksum(&b[..CRC_AT]) != u32_at(b, CRC_AT)
-        || u32_at(b, RECORD_LEN) != COMMIT_MAGIC
-        || u32_at(b, RECORD_LEN + 4) != sequence
+        || u32_at(commit, 0) != COMMIT_MAGIC
+        || u32_at(commit, 4) != sequence
     {
         return Page::Corrupt;
     }

@@ -16,8 +16,11 @@
 //! ([`crate::Controller`] applies it between control steps, bumplessly).
 //!
 //! Ids are grouped by tens (current loop 1–5, speed loop 10–15, pressure loop 20–25,
-//! hydraulics 30–36, telemetry 40, commissioning results 50–54); an id is never reused for
-//! another meaning. The stored table ([`crate::param_store`]) carries a fingerprint of this
+//! hydraulics 30–36, telemetry 40, commissioning results 50–54, torque feed-forward 60–63);
+//! an id is never reused for another meaning. `compensation.clear` is an action: writing 1
+//! empties the feed-forward's table ([`crate::compensation`]), it always reads 0. The
+//! feed-forward's amplitude limit also involves its table, which the controller checks
+//! ([`crate::compensation::Compensation::check_amplitude`]). The stored table ([`crate::param_store`]) carries a fingerprint of this
 //! list ([`LAYOUT_FINGERPRINT`]), so a firmware with a changed table never loads an old
 //! record as if it matched.
 //!
@@ -58,6 +61,10 @@
 //! | 52 | `motor.q_inductance_h` | H | 0.000001 | 1 | 0.012 |
 //! | 53 | `motor.flux_linkage_wb` | Wb | 0 | 5 | 0.1827 |
 //! | 54 | `sensors.encoder_offset_rad` | rad | 0 | 6.2831855 | 0 |
+//! | 60 | `compensation.enabled` | 1 | 0 | 1 | 0 |
+//! | 61 | `compensation.scale` | 1 | 0 | 2 | 1 |
+//! | 62 | `compensation.max_current_a` | A | 0 | 10 | 3 |
+//! | 63 | `compensation.clear` | 1 | 0 | 1 | 0 |
 //!
 //! The table above is checked against the code by this module's tests.
 
@@ -65,7 +72,7 @@ use crate::config::{Config, ConfigError};
 use core::fmt;
 
 /// Number of parameters in the table.
-pub const COUNT: usize = 30;
+pub const COUNT: usize = 34;
 
 /// A parameter of the live table; the discriminant is the wire id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -131,6 +138,14 @@ pub enum ParamId {
     FluxLinkage = 53,
     /// Commissioned encoder electrical offset `sensors.encoder_offset_rad`. [rad]
     EncoderOffset = 54,
+    /// Torque feed-forward on (1) or off (0) `compensation.enabled`. [1]
+    CompensationEnabled = 60,
+    /// Gain on the feed-forward's table `compensation.scale`. [1]
+    CompensationScale = 61,
+    /// Largest feed-forward amplitude `compensation.max_current_a`. [A]
+    CompensationMaxCurrent = 62,
+    /// Action: 1 empties the feed-forward's table `compensation.clear`. [1]
+    CompensationClear = 63,
 }
 
 /// Name, unit and bounds of one parameter.
@@ -183,6 +198,10 @@ impl ParamId {
         ParamId::QInductance,
         ParamId::FluxLinkage,
         ParamId::EncoderOffset,
+        ParamId::CompensationEnabled,
+        ParamId::CompensationScale,
+        ParamId::CompensationMaxCurrent,
+        ParamId::CompensationClear,
     ];
 
     const fn spec(self) -> Spec {
@@ -228,6 +247,10 @@ impl ParamId {
                 0.0,
                 core::f32::consts::TAU,
             ),
+            CompensationEnabled => spec("compensation.enabled", "1", 0.0, 1.0),
+            CompensationScale => spec("compensation.scale", "1", 0.0, 2.0),
+            CompensationMaxCurrent => spec("compensation.max_current_a", "A", 0.0, 10.0),
+            CompensationClear => spec("compensation.clear", "1", 0.0, 1.0),
         }
     }
 
@@ -274,7 +297,18 @@ impl ParamId {
 
     /// True for a parameter that takes whole numbers only.
     pub fn is_integer(self) -> bool {
-        self == ParamId::TelemetryDecimation
+        matches!(
+            self,
+            ParamId::TelemetryDecimation
+                | ParamId::CompensationEnabled
+                | ParamId::CompensationClear
+        )
+    }
+
+    /// True for an action rather than a setting: writing it does something once, it is
+    /// not a configuration field and always reads 0 (`compensation.clear`).
+    pub fn is_action(self) -> bool {
+        self == ParamId::CompensationClear
     }
 
     /// Default: the value in [`Config::nominal`]. [unit]
@@ -317,6 +351,10 @@ impl ParamId {
             QInductance => cfg.motor.q_inductance_h,
             FluxLinkage => cfg.motor.flux_linkage_wb,
             EncoderOffset => cfg.sensors.encoder_offset_rad,
+            CompensationEnabled => f32::from(u8::from(cfg.compensation.enabled)),
+            CompensationScale => cfg.compensation.scale,
+            CompensationMaxCurrent => cfg.compensation.max_current_a,
+            CompensationClear => 0.0,
         }
     }
 
@@ -353,11 +391,19 @@ impl ParamId {
                 cfg.rates.telemetry_decimation = value as u32;
                 return;
             }
+            CompensationEnabled => {
+                // Checked to be 0 or 1 before this is reached.
+                cfg.compensation.enabled = value != 0.0;
+                return;
+            }
+            CompensationClear => return,
             StatorResistance => &mut cfg.motor.stator_resistance_ohm,
             DInductance => &mut cfg.motor.d_inductance_h,
             QInductance => &mut cfg.motor.q_inductance_h,
             FluxLinkage => &mut cfg.motor.flux_linkage_wb,
             EncoderOffset => &mut cfg.sensors.encoder_offset_rad,
+            CompensationScale => &mut cfg.compensation.scale,
+            CompensationMaxCurrent => &mut cfg.compensation.max_current_a,
         };
         *slot = value;
     }

@@ -28,13 +28,15 @@ pub fn max_sampled_duty(settle_s: f32, pwm_hz: f32) -> f32 {
     }
 }
 
+use crate::svpwm::DutyWindow;
+
 /// No phase to rebuild.
 const NONE: u8 = 3;
 
 /// The phases that were above the window in the last two periods.
 #[derive(Clone, Copy, Debug)]
 pub struct SamplingWindow {
-    max_duty: f32,
+    duty: DutyWindow,
     /// Phase (0‥2) above the window in the last recorded period, or [`NONE`].
     last: u8,
     /// Phase (0‥2) to rebuild in the next sample, or [`NONE`].
@@ -45,7 +47,7 @@ impl SamplingWindow {
     /// For the largest readable duty `max_duty` [1]; nothing recorded yet.
     pub fn new(max_duty: f32) -> SamplingWindow {
         SamplingWindow {
-            max_duty,
+            duty: DutyWindow::new(max_duty),
             last: NONE,
             rebuild: NONE,
         }
@@ -53,7 +55,12 @@ impl SamplingWindow {
 
     /// Largest readable duty. [1]
     pub fn max_duty(&self) -> f32 {
-        self.max_duty
+        self.duty.max_duty
+    }
+
+    /// The window as the modulator's common path takes it.
+    pub fn duty_window(&self) -> DutyWindow {
+        self.duty
     }
 
     /// Forgets the duties (bridge off: no phase is left in a long high-side interval).

@@ -125,11 +125,15 @@ pub enum FaultCode {
     /// measured below a tenth of the speed limit: a locked rotor, or an encoder that does
     /// not see the shaft turn (stuck, reversed). (20)
     Stall = 20,
+    /// The stored torque feed-forward table was refused (wrong size, format version or
+    /// CRC, or an amplitude above `compensation.max_current_a`): the drive runs
+    /// uncompensated. (21)
+    CompensationTableInvalid = 21,
 }
 
 impl FaultCode {
     /// All codes, in bit order.
-    pub const ALL: [FaultCode; 20] = [
+    pub const ALL: [FaultCode; 21] = [
         FaultCode::PhaseOverCurrent,
         FaultCode::DcLinkOverVoltage,
         FaultCode::DcLinkUnderVoltage,
@@ -150,10 +154,11 @@ impl FaultCode {
         FaultCode::ParameterFlashLayout,
         FaultCode::PhaseCurrentSum,
         FaultCode::Stall,
+        FaultCode::CompensationTableInvalid,
     ];
 
     /// Largest telemetry code.
-    pub const MAX_CODE: u8 = FaultCode::Stall as u8;
+    pub const MAX_CODE: u8 = FaultCode::CompensationTableInvalid as u8;
 
     /// Telemetry code (1..=[`FaultCode::MAX_CODE`]).
     pub fn code(self) -> u8 {
@@ -186,6 +191,7 @@ impl FaultCode {
                 | FaultCode::HardwareBreak
                 | FaultCode::ParameterFlashLayout
                 | FaultCode::Stall
+                | FaultCode::CompensationTableInvalid
         )
     }
 }
@@ -222,6 +228,9 @@ impl FaultCode {
                 "phase currents do not sum to zero (current sensor or earth fault)"
             }
             FaultCode::Stall => "stall: current at its limit, shaft not turning",
+            FaultCode::CompensationTableInvalid => {
+                "stored torque feed-forward table refused, running uncompensated"
+            }
         }
     }
 }

@@ -43,6 +43,11 @@ pub struct Modulation {
     pub above_window: Option<u8>,
 }
 
+/// The hexagon's span `max(v) − min(v)` a command may use, as a fraction of U_dc: a hair
+/// inside the hexagon, so that the unclamped duties of the common path stay inside [0, 1]
+/// whatever the f32 rounding (see [`modulate_finite`]); 15 ppm of the voltage. [1]
+pub const SPAN_LIMIT: f32 = 1.0 - 1.0 / 65536.0;
+
 /// Duties for the α-β voltage `v` [V] from the DC link `u_dc` [V]. A DC link below 1 V
 /// gives 50 % on all phases (zero voltage).
 #[inline]
@@ -52,16 +57,53 @@ pub fn modulate(v: AlphaBeta, u_dc: f32) -> Modulation {
 
 /// As [`modulate`], with at most one duty above `max_sampled_duty` (the largest duty whose
 /// low-side shunt can still be read, see the module documentation); `1.0` is [`modulate`].
-/// Always inlined (it is the current loop's hot path), its rare branch never.
+/// A non-finite command or a DC link below 1 V (or NaN) gives 50 % on all phases.
 #[inline(always)]
 pub fn modulate_sampled(v: AlphaBeta, u_dc: f32, max_sampled_duty: f32) -> Modulation {
-    if u_dc.is_nan() || u_dc < 1.0 || !(v.alpha.is_finite() && v.beta.is_finite()) {
-        return Modulation {
-            duties: [0.5; 3],
-            limited: true,
-            applied: AlphaBeta::default(),
-            above_window: None,
-        };
+    if !(v.alpha.is_finite() && v.beta.is_finite()) {
+        return Modulation::ZERO;
+    }
+    modulate_finite(v, u_dc, DutyWindow::new(max_sampled_duty))
+}
+
+/// The sampling window as the modulator's common path uses it: the largest readable duty
+/// w and the largest span (as a fraction of U_dc) that keeps every duty within it and
+/// inside [`SPAN_LIMIT`], `min(2w − 1, SPAN_LIMIT)`, computed once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DutyWindow {
+    /// Largest readable duty w. [1]
+    pub max_duty: f32,
+    /// Largest span of the common path. [1]
+    pub common_span: f32,
+}
+
+impl DutyWindow {
+    /// For the largest readable duty `max_duty` [1].
+    pub fn new(max_duty: f32) -> DutyWindow {
+        let top = 2.0 * max_duty - 1.0;
+        DutyWindow {
+            max_duty,
+            common_span: if top < SPAN_LIMIT { top } else { SPAN_LIMIT },
+        }
+    }
+}
+
+/// [`modulate_sampled`] for a command known to be finite (the current loop's: its PIs'
+/// outputs are saturated finite values, its sine table finite for any angle). A DC link
+/// below 1 V (or NaN) gives 50 % on all phases. Always inlined (the current loop's hot
+/// path); a command beyond the hexagon or the window takes a cold branch.
+///
+/// No clamp on the common path: with the span at most [`SPAN_LIMIT`]·U_dc each phase's
+/// distance from the centring offset is at most half the span (the three phase voltages
+/// sum to zero, so the highest is ≥ 0 ≥ the lowest and every rounding error is relative
+/// to the span), so `(x + offset)/U_dc` is below ½ by far more than the few ulps the f32
+/// arithmetic can add, and `½ + (x + offset)/U_dc` rounds into [0, 1].
+#[inline(always)]
+pub fn modulate_finite(v: AlphaBeta, u_dc: f32, window: DutyWindow) -> Modulation {
+    // One comparison that also refuses NaN.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(u_dc >= 1.0) {
+        return Modulation::ZERO;
     }
     let [a, b, c] = inverse_clarke(v);
     // Comparisons rather than f32::max/min: those become fmaxf/fminf calls on the M4F.
@@ -69,50 +111,69 @@ pub fn modulate_sampled(v: AlphaBeta, u_dc: f32, max_sampled_duty: f32) -> Modul
     let max = if c > hi_ab { c } else { hi_ab };
     let min = if c < lo_ab { c } else { lo_ab };
     let span = max - min;
-    let (mut scale, mut limited) = if span > u_dc {
-        (u_dc / span, true)
-    } else {
-        (1.0, false)
-    };
-    let mut k = scale / u_dc;
+    let k = 1.0 / u_dc;
     let zero = -0.5 * (max + min);
     // The highest duty is 1/2 + span·k/2: at or below the window (the usual case) the
     // middle one is too, and nothing moves.
-    let mut base = 0.5;
-    let mut above_window = None;
-    if span * k > 2.0 * max_sampled_duty - 1.0 {
-        (k, base, limited, above_window) =
-            keep_middle_readable([a, b, c], max, min, zero, k, max_sampled_duty, limited);
-        scale = k * u_dc;
+    if span * k > window.common_span {
+        let p = Phases {
+            v: [a, b, c],
+            max,
+            min,
+            zero,
+        };
+        return beyond_common(v, p, u_dc, window.max_duty);
     }
-    let duty = |x: f32| (base + (x + zero) * k).clamp(0.0, 1.0);
+    let duty = |x: f32| 0.5 + (x + zero) * k;
     Modulation {
         duties: [duty(a), duty(b), duty(c)],
-        limited,
-        applied: AlphaBeta {
-            alpha: v.alpha * scale,
-            beta: v.beta * scale,
-        },
-        above_window,
+        limited: false,
+        applied: v,
+        above_window: None,
     }
 }
 
-/// The highest duty is above the window `w`: returns the volts-to-duty factor, the duty
-/// of zero voltage (1/2 less the zero-sequence shift), whether the vector was limited,
-/// and the phase still above the window, so that the middle duty is at most `w` (see the
-/// module documentation). `v` are the phase voltages, `max`, `min` the highest and lowest
-/// of them, `zero` the centring offset [V], `k` the factor so far [1/V].
-#[cold]
-#[inline(never)]
-fn keep_middle_readable(
+impl Modulation {
+    /// 50 % on every phase: zero voltage.
+    pub const ZERO: Modulation = Modulation {
+        duties: [0.5; 3],
+        limited: true,
+        applied: AlphaBeta {
+            alpha: 0.0,
+            beta: 0.0,
+        },
+        above_window: None,
+    };
+}
+
+/// The phase voltages of a command and where they sit. [V]
+#[derive(Clone, Copy)]
+struct Phases {
+    /// Phase voltages a, b, c (summing to zero).
     v: [f32; 3],
+    /// The highest and lowest of them.
     max: f32,
     min: f32,
+    /// The centring offset −(max + min)/2.
     zero: f32,
-    k: f32,
-    w: f32,
-    limited: bool,
-) -> (f32, f32, bool, Option<u8>) {
+}
+
+/// The command is beyond the hexagon (its span above [`SPAN_LIMIT`]·U_dc) or its highest
+/// duty above the window `w`: the command limited to the hexagon keeping its angle, then
+/// the modulation of `cmd` (phases `p`, from the DC link `u_dc`) with the middle duty at
+/// most `w` (see the module documentation). The duties are clamped to [0, 1] against
+/// rounding here, off the common path.
+#[cold]
+#[inline(never)]
+fn beyond_common(cmd: AlphaBeta, p: Phases, u_dc: f32, w: f32) -> Modulation {
+    let span = p.max - p.min;
+    let linear = 1.0 / u_dc;
+    let (k, limited) = if span * linear > SPAN_LIMIT {
+        (SPAN_LIMIT / span, true)
+    } else {
+        (linear, false)
+    };
+    let Phases { v, max, min, zero } = p;
     // The phase voltages sum to zero.
     let mid = -(max + min);
     let (k, limited) = if (mid - min) * k > w {
@@ -123,17 +184,26 @@ fn keep_middle_readable(
     let d_mid = 0.5 + (mid + zero) * k;
     let shift = if d_mid > w { d_mid - w } else { 0.0 };
     let base = 0.5 - shift;
-    let above = (base + (max + zero) * k > w).then(|| {
-        let [a, b, _] = v;
-        if max == a {
-            0
-        } else if max == b {
-            1
-        } else {
-            2
-        }
-    });
-    (k, base, limited, above)
+    let [a, b, c] = v;
+    let top = if max == a {
+        0
+    } else if max == b {
+        1
+    } else {
+        2
+    };
+    let above_window = (base + (max + zero) * k > w).then_some(top);
+    let duty = |x: f32| (base + (x + zero) * k).clamp(0.0, 1.0);
+    let scale = k * u_dc;
+    Modulation {
+        duties: [duty(a), duty(b), duty(c)],
+        limited,
+        applied: AlphaBeta {
+            alpha: cmd.alpha * scale,
+            beta: cmd.beta * scale,
+        },
+        above_window,
+    }
 }
 
 #[cfg(test)]

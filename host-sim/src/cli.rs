@@ -8,6 +8,7 @@
 //! panics.
 
 use crate::commission::CommissionArgs;
+use crate::compensate::CompensateArgs;
 use crate::diagnose::command::DiagnoseArgs;
 use crate::ingest::IngestArgs;
 use crate::output::paths::{self, Declared};
@@ -61,6 +62,9 @@ pub enum Command {
     Watch(WatchArgs),
     /// Say what the simulation gets wrong on a bench log, and why.
     Diagnose(DiagnoseArgs),
+    /// Learn the angle-indexed torque feed-forward from bench logs: table, CAN frames,
+    /// predicted pulsation.
+    Compensate(CompensateArgs),
 }
 
 /// Parses the process's arguments, runs, reports; the binary's whole `main`.
@@ -103,6 +107,7 @@ impl Command {
             Command::Ingest(a) => a.paths(),
             Command::Watch(a) => a.paths(),
             Command::Diagnose(a) => a.paths(),
+            Command::Compensate(a) => a.paths(),
         }
     }
 }
@@ -126,6 +131,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Ingest(a) => crate::ingest::run_ingest(a),
         Command::Watch(a) => crate::watch::run_watch(&rig, a),
         Command::Diagnose(a) => crate::diagnose::command::run_diagnose(&rig, a),
+        Command::Compensate(a) => crate::compensate::run_compensate(&rig, a),
     }
 }
 

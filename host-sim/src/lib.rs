@@ -20,6 +20,7 @@ pub mod bench_log;
 pub mod can_commands;
 pub mod cli;
 pub mod commission;
+pub mod compensate;
 pub mod diagnose;
 pub mod ingest;
 pub mod output;

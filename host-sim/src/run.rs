@@ -12,7 +12,10 @@
 use crate::bench_log::limits::{physical_range, MAX_ROWS};
 use crate::bench_log::BenchLog;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
+use firmware::compensation::Table;
 use firmware::config::Config;
+use firmware::parameters::ParamId;
+use firmware::Command;
 use indicatif::{ProgressBar, ProgressStyle};
 use plant_model::Rig;
 use std::time::{Duration, Instant};
@@ -46,6 +49,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Metadata lines for the log.
     pub metadata: Vec<(String, String)>,
+    /// A torque feed-forward table loaded into the controller before the run, and enabled,
+    /// as the drive loads it from flash (`None`: uncompensated).
+    pub compensation: Option<Table>,
 }
 
 /// How a run of `duration_s` [s] is logged at `log_rate_hz` [Hz] with the PWM period
@@ -73,6 +79,19 @@ pub fn first_unphysical(log: &BenchLog) -> Option<(f64, &'static str, f64)> {
     first.map(|(i, name, v)| (log.t_s.get(i).copied().unwrap_or(f64::NAN), name, v))
 }
 
+/// Installs `table` in the loop's controller and enables the feed-forward, as the drive
+/// does at boot from its stored table (the amplitude limit checked the same way).
+pub fn load_compensation(cl: &mut ClosedLoop, table: &Table) -> Result<(), String> {
+    let c = cl.controller_mut();
+    c.install_compensation(table)
+        .map_err(|e| format!("the drive refuses the table: {e}"))?;
+    c.command(Command::SetParameter {
+        id: ParamId::CompensationEnabled,
+        value: 1.0,
+    })
+    .map_err(|e| format!("the drive refuses to enable the table: {e}"))
+}
+
 /// Runs `scenario` on the plant `plant_rig`, controlled by the configuration of
 /// `controller_rig` (the rig file the engineer believes in). Fails before any work if the
 /// log would exceed [`MAX_ROWS`].
@@ -95,6 +114,9 @@ pub fn run_with_config(
 ) -> Result<Run, String> {
     let mut cl =
         ClosedLoop::new(plant_rig, config, scenario, opt.seed).map_err(|e| e.to_string())?;
+    if let Some(table) = &opt.compensation {
+        load_compensation(&mut cl, table)?;
+    }
     let (every, rows) = log_plan(opt.duration_s, opt.log_rate_hz, cl.period_s());
     if rows.is_nan() || rows > MAX_ROWS as f64 {
         return Err(format!(

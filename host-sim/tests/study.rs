@@ -27,6 +27,7 @@ fn dominant_with(effect: &str) -> (f64, f64) {
             seed: 3,
             progress: false,
             metadata: vec![],
+            compensation: None,
         },
     )
     .unwrap();

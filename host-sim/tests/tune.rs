@@ -30,6 +30,7 @@ fn log_of(plant: &Rig, controller: &Rig, scenario: &str) -> BenchLog {
             seed: 1,
             progress: false,
             metadata: Vec::new(),
+            compensation: None,
         },
     )
     .expect("the run succeeds")

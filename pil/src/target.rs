@@ -5,6 +5,7 @@ use crate::icount::{self, Tally};
 use closed_loop::{by_name, controller_config, ClosedLoop};
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use defmt_semihosting as _;
+use firmware::compensation::{Compensation, Table, BINS, CHANNELS};
 use firmware::current_loop::CurrentLoop;
 use firmware::pressure_loop::PressureLoop;
 use firmware::speed_loop::SpeedLoop;
@@ -61,6 +62,10 @@ fn run() -> Result<(), ()> {
     // controller saw (the ADC counts, the telemetry's angle, speeds and references): the
     // same code as inside `Controller::on_current_sample`, bracketed alone.
     let mut current = CurrentLoop::new(&config);
+    let Some(compensation) = feed_forward(&config) else {
+        defmt::error!("PIL: the feed-forward's test table was refused");
+        return Err(());
+    };
     let mut speed = SpeedLoop::new(&config);
     let mut pressure = PressureLoop::new(&config);
     pressure.reset(scenario.initial_pressure_pa as f32, 0.0);
@@ -75,7 +80,7 @@ fn run() -> Result<(), ()> {
         Tally::default(),
     );
     // Two parts of the current-loop step, for what dominates it: the sine/cosine pair of
-    // the angle (micromath) and the space-vector modulator (with its division by U_dc).
+    // the angle (the sine table) and the space-vector modulator (with its division by U_dc).
     let (mut t_sin_cos, mut t_svpwm) = (Tally::default(), Tally::default());
     let mut rows: u32 = 0;
     for k in 0..steps {
@@ -92,13 +97,16 @@ fn run() -> Result<(), ()> {
         }
         let tel = s.telemetry;
         t_empty.measure((), |()| ());
-        t_current.measure(&mut current, |c| {
+        // The current-loop step as the controller runs it in Speed and Pressure: the
+        // torque feed-forward looked up and added to the q reference, then the step.
+        t_current.measure((&mut current, &compensation), |(c, ff)| {
+            let iq_ff = ff.current(tel.theta_m_rad, tel.speed_rad_s, tel.p_pa, tel.iq_ref_a);
             c.step(
                 &m,
                 tel.theta_m_rad * pole_pairs,
                 Dq {
                     d: 0.0,
-                    q: tel.iq_ref_a,
+                    q: tel.iq_ref_a + iq_ff,
                 },
                 tel.speed_rad_s * pole_pairs,
             )
@@ -138,6 +146,25 @@ fn run() -> Result<(), ()> {
         rows
     );
     Ok(())
+}
+
+/// An active feed-forward for the measurement: every channel non-zero (a 72/rev line in
+/// the constant channel, 18/rev per pressure, 24/rev per current, a few percent of the
+/// nominal rig's torques), so the step takes its full path.
+fn feed_forward(config: &firmware::Config) -> Option<Compensation> {
+    let mut cfg = *config;
+    cfg.compensation.enabled = true;
+    let mut raw = [[0i16; CHANNELS]; BINS];
+    for (b, r) in raw.iter_mut().enumerate() {
+        let th = b as f32 * core::f32::consts::TAU / BINS as f32;
+        let line = |k: f32| libm::sinf(k * th) * 20_000.0;
+        *r = [line(72.0) as i16, line(18.0) as i16, line(24.0) as i16];
+    }
+    // 0.05 A, 1.2e-9 A/Pa (6 mA at 5 MPa), 0.02 A/A full scale.
+    let table = Table::from_raw([19, 44, 20], &raw)?;
+    let mut c = Compensation::new(&cfg);
+    c.install(&table, &cfg).ok()?;
+    c.is_active().then_some(c)
 }
 
 #[defmt::panic_handler]

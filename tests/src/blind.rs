@@ -451,6 +451,7 @@ pub fn simulate(
         seed: noise_seed,
         progress: false,
         metadata: vec![("source".into(), "blind-suite".into())],
+        compensation: None,
     };
     let config = controller.apply(&controller_config(&Rig::nominal()));
     Ok(run_with_config(plant_rig, &config, scenario, &opt)?.log)

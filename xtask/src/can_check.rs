@@ -111,6 +111,25 @@ fn expected_command(r: &Request) -> Expected {
         | Request::Heartbeat
         | Request::SaveParameters
         | Request::Commission => e,
+        Request::CompensationHeader { exponents, bins } => {
+            let [e0, e1, e2] = exponents.map(|x| x as u8);
+            e.int("Bin", 0xFFFF, 1.0)
+                .int("Raw0", i64::from(i16::from_le_bytes([e0, e1])), 1.0)
+                .int("Raw1", i64::from(i16::from_le_bytes([e2, 0])), 1.0)
+                .int("Raw2", i64::from(bins as i16), 1.0)
+        }
+        Request::CompensationBin { bin, raw } => e
+            .int("Bin", i64::from(bin), 1.0)
+            .int("Raw0", i64::from(raw[0]), 1.0)
+            .int("Raw1", i64::from(raw[1]), 1.0)
+            .int("Raw2", i64::from(raw[2]), 1.0),
+        Request::CompensationCommit { crc } => e.int("Crc", i64::from(crc), 1.0),
+        Request::CompensationSweep {
+            speed_rad_s,
+            leg_ms,
+        } => e
+            .float("SweepSpeed", speed_rad_s)
+            .int("LegDuration", i64::from(leg_ms), ms_factor()),
     }
 }
 
@@ -170,7 +189,10 @@ fn expected_reply(r: &Reply) -> Expected {
                 Function::SetParameter
                 | Function::GetParameter
                 | Function::SaveParameters
-                | Function::StepTest => e.float(&bound, f32::from_bits(j.bound as u32)),
+                | Function::StepTest
+                | Function::CompensationBin
+                | Function::CompensationCommit
+                | Function::CompensationSweep => e.float(&bound, f32::from_bits(j.bound as u32)),
                 Function::SetPressure => e.int(
                     &bound,
                     i64::from(j.bound),
@@ -244,6 +266,31 @@ fn samples() -> Vec<Sample> {
                 })
                 .collect(),
             Function::Commission => vec![Request::Commission],
+            Function::CompensationBin => vec![
+                Request::CompensationHeader {
+                    exponents: [19, 40, -3],
+                    bins: 512,
+                },
+                Request::CompensationBin {
+                    bin: 0,
+                    raw: [0, 0, 0],
+                },
+                Request::CompensationBin {
+                    bin: 511,
+                    raw: [i16::MIN, -1234, i16::MAX],
+                },
+            ],
+            Function::CompensationCommit => [0u32, 0x8123_FB45, u32::MAX]
+                .iter()
+                .map(|crc| Request::CompensationCommit { crc: *crc })
+                .collect(),
+            Function::CompensationSweep => [(10.0f32, 6000u16), (-2.5, 1), (1e3, 65_535)]
+                .iter()
+                .map(|(w, ms)| Request::CompensationSweep {
+                    speed_rad_s: *w,
+                    leg_ms: *ms,
+                })
+                .collect(),
         };
         v.extend(requests.into_iter().map(Sample::Command));
     }

@@ -351,6 +351,39 @@ fn command(f: Function) -> Message {
             "run the commissioning sequence (motor identification) in Calibrating",
             Vec::new(),
         ),
+        Function::CompensationBin => (
+            "CompensationBin",
+            "one bin of the torque feed-forward table, in order from 0 after the header \
+             (bin 65535: bytes 2-4 the three channels' LSB exponents as i8, byte 5 zero, \
+             bytes 6-7 the bin count)",
+            vec![
+                signal("Bin", 0, 16, Kind::Unsigned).about("bin index; 65535 the header"),
+                signal("Raw0", 2, 16, Kind::Signed)
+                    .about("constant channel, LSB 2^-e0 A (header: exponents e0, e1)"),
+                signal("Raw1", 4, 16, Kind::Signed)
+                    .about("per-pressure channel, LSB 2^-e1 A/Pa (header: exponent e2)"),
+                signal("Raw2", 6, 16, Kind::Signed)
+                    .about("per-current channel, LSB 2^-e2 A/A (header: bin count)"),
+            ],
+        ),
+        Function::CompensationCommit => (
+            "CompensationCommit",
+            "end the table load; the table takes effect if its CRC and amplitude pass",
+            vec![signal("Crc", 0, 32, Kind::Unsigned)
+                .about("CRC-32 of the table's record (firmware::compensation::record)")],
+        ),
+        Function::CompensationSweep => (
+            "CompensationSweep",
+            "the feed-forward's bench sweep: constant speed both ways, in Speed mode",
+            vec![
+                signal("SweepSpeed", 0, 32, Kind::Float)
+                    .unit("rad/s")
+                    .about("speed of the first leg"),
+                signal("LegDuration", 4, 16, Kind::Unsigned)
+                    .scaled(1e-3, "s")
+                    .about("duration of each leg (ms on the wire)"),
+            ],
+        ),
     };
     Message {
         base: f.id_base(),
@@ -402,13 +435,17 @@ fn reject_bound(f: Function) -> Signal {
         Function::SetParameter
         | Function::GetParameter
         | Function::SaveParameters
-        | Function::StepTest => Signal {
+        | Function::StepTest
+        | Function::CompensationBin
+        | Function::CompensationCommit
+        | Function::CompensationSweep => Signal {
             kind: Kind::Float,
             ..base
         }
         .about(
             "violated bound as f32 in SI units (the parameter's unit; A, rad/s, Pa or s for a \
-             step; the needed mode for reason 5); for reasons 3, 6, 8 the bits are an integer",
+             step; the amplitude limit in A or the bin expected for a table frame; the needed \
+             mode for reason 5); for reasons 3, 6, 8 the bits are an integer",
         ),
         Function::SetMode | Function::ClearFaults | Function::Heartbeat | Function::Commission => {
             base.about(

@@ -141,7 +141,14 @@ pub fn pil() -> Result<()> {
     if let Some((name, d)) = diffs.iter().find(|(_, d)| *d != 0.0) {
         bail!(
             "the PIL and host runs differ ({name} by {d}): shared code must call float \
-             functions through libm/micromath on both (see target/pil/pil.csv and host.csv)"
+             functions through libm or the firmware's own tables on both (see \
+             target/pil/pil.csv and host.csv)"
+        );
+    }
+    if current > goal {
+        bail!(
+            "the current-loop step takes {current:.0} instructions, above its ceiling of \
+             {goal:.0} (pil/budget.toml, current_loop_goal_instructions)"
         );
     }
     if current > budget * (1.0 + BUDGET_TOLERANCE_PERCENT / 100.0) {

@@ -46,8 +46,26 @@ pub struct Drive {
     telemetry_countdown: u32,
 }
 
-static DRIVE: CriticalSectionMutex<RefCell<Option<Drive>>> =
-    CriticalSectionMutex::new(RefCell::new(None));
+/// The drive once installed. An explicit zero tag for "empty" (not `Option`, whose `None`
+/// would take a niche value inside the controller): the static is then all zero and lives
+/// in `.bss`, instead of an 8 KiB initial image in flash.
+#[repr(u8)]
+enum Slot {
+    Empty = 0,
+    Installed(Drive) = 1,
+}
+
+impl Slot {
+    fn as_mut(&mut self) -> Option<&mut Drive> {
+        match self {
+            Slot::Empty => None,
+            Slot::Installed(d) => Some(d),
+        }
+    }
+}
+
+static DRIVE: CriticalSectionMutex<RefCell<Slot>> =
+    CriticalSectionMutex::new(RefCell::new(Slot::Empty));
 static ISR_COUNT: AtomicU32 = AtomicU32::new(0);
 static ISR_MAX_CYCLES: AtomicU32 = AtomicU32::new(0);
 static OVERRUNS: AtomicU32 = AtomicU32::new(0);
@@ -60,7 +78,7 @@ static TELEMETRY: Channel<CriticalSectionRawMutex, TelemetryFrame, TELEMETRY_QUE
 /// Installs the drive; the interrupt does nothing before this.
 pub fn install(controller: Controller, bridge: Bridge, sensors: Sensors) {
     DRIVE.lock(|d| {
-        d.replace(Some(Drive {
+        d.replace(Slot::Installed(Drive {
             controller,
             bridge,
             sensors,

@@ -15,7 +15,9 @@
 //! logged), peripherals brought up with the bridge disabled, the stored parameter table
 //! applied over the defaults ([`firmware::param_store::boot`]: a corrupt, other-version
 //! or inconsistent record gives the defaults and latches fault 16; a flash without the
-//! dual-bank layout gives the defaults and fault 18), a watchdog reset of the previous run
+//! dual-bank layout gives the defaults and fault 18), the stored torque feed-forward table
+//! loaded (a wrong size, version, CRC or amplitude refuses it alone: fault 21, the drive
+//! runs uncompensated), a watchdog reset of the previous run
 //! latched as fault 11, the drive installed, the interrupt enabled, the tasks spawned. The
 //! drive starts in Disabled and measures its current offsets; a CAN `SetMode` command
 //! starts it once the offsets are measured and (for Speed and Pressure) the encoder index
@@ -36,7 +38,8 @@ use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_time::Timer;
 use firmware::can_protocol::NodeId;
-use firmware::param_store::{boot, BootOutcome};
+use firmware::compensation::CompensationError;
+use firmware::param_store::{boot, BootOutcome, TABLE_LEN};
 use firmware::{Config, Controller};
 
 use bridge::Bridge;
@@ -128,7 +131,31 @@ fn load_parameters(
     };
     match boot(&mut store, |v| controller.load_parameters(v).is_ok()) {
         BootOutcome::Stored { sequence } => {
-            defmt::info!("parameters: stored table {} loaded", sequence)
+            defmt::info!("parameters: stored table {} loaded", sequence);
+            let read = |at: usize, buf: &mut [u8]| store.read_table(at, buf);
+            match controller.load_compensation_record(TABLE_LEN, read) {
+                Ok(()) => defmt::info!(
+                    "torque feed-forward: table loaded (amplitude bound {=f32} A)",
+                    controller.compensation().amplitude_bound()
+                ),
+                Err(e) => {
+                    match e {
+                        CompensationError::Amplitude {
+                            amplitude_a,
+                            limit_a,
+                        } => defmt::error!(
+                            "torque feed-forward: amplitude {=f32} A above compensation.max_current_a {=f32} A",
+                            amplitude_a,
+                            limit_a
+                        ),
+                        CompensationError::Record(r) => {
+                            defmt::error!("torque feed-forward: stored table refused, {=str}", r.kind())
+                        }
+                    }
+                    defmt::error!("torque feed-forward: running uncompensated (fault 21)");
+                    controller.report_compensation_invalid();
+                }
+            }
         }
         BootOutcome::Defaults => defmt::info!("parameters: none stored, defaults"),
         BootOutcome::DefaultsAfterInvalid(_) => {

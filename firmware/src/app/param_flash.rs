@@ -34,6 +34,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use embassy_stm32::flash::{Blocking, Flash, FLASH_SIZE, MAX_ERASE_SIZE};
 use embassy_stm32::pac;
 use embassy_stm32::pac::iwdg::vals::Key;
+use firmware::compensation::record::Encoder;
 use firmware::param_store::{ParamStore, StoreError, SPAN};
 use firmware::parameters::COUNT;
 
@@ -42,10 +43,11 @@ pub type Store = ParamStore<Flash<'static, Blocking>>;
 
 /// Erase page of bank 2 in dual-bank mode. [bytes]
 pub const PAGE_BYTES: u32 = MAX_ERASE_SIZE as u32;
-/// One slot (A or B) of the stored record: a whole number of [`PAGE_BYTES`]. One page
-/// holds today's record ([`SPAN`] bytes: the live table with header, CRC and commit
-/// word); grow it in whole pages when the record grows. [bytes]
-pub const SLOT_BYTES: u32 = PAGE_BYTES;
+/// One slot (A or B) of the stored record: a whole number of [`PAGE_BYTES`]. Two pages
+/// hold the record ([`SPAN`] bytes: the live table with header and CRC, the torque
+/// feed-forward's table record, the commit word); grow it in whole pages when the record
+/// grows. [bytes]
+pub const SLOT_BYTES: u32 = 2 * PAGE_BYTES;
 /// Offset of bank 2 from the flash start. [bytes]
 pub const BANK2: u32 = (FLASH_SIZE / 2) as u32;
 /// Offset of slot B (the last slot of bank 2) from the flash start. [bytes]
@@ -78,15 +80,26 @@ pub fn open(
     ParamStore::new(flash, SLOT_A, SLOT_B, SLOT_BYTES)
 }
 
-/// Saves `values` with the watchdog stretched; returns the record's sequence number. Call
-/// only with the bridge disabled.
+/// Saves `values` and the controller's torque feed-forward table with the watchdog
+/// stretched; returns the record's sequence number. Call only with the bridge disabled.
+/// The table's record is copied out of the controller 48 bytes at a time, each copy a
+/// short critical section, never across a flash operation.
 pub fn save(
     store: &mut Store,
     values: &[f32; COUNT],
 ) -> Result<u32, StoreError<embassy_stm32::flash::Error>> {
     MAINTENANCE.fetch_add(1, Ordering::Relaxed);
     let reload = set_watchdog_reload(IWDG_RELOAD_MAX);
-    let result = store.save(values);
+    let mut encoder = Encoder::new();
+    let result = store.save(values, |buf| {
+        super::control::with_controller(|c| {
+            encoder.next(c.compensation().table()).map(|(at, bytes)| {
+                buf[..bytes.len()].copy_from_slice(bytes);
+                (at, bytes.len())
+            })
+        })
+        .flatten()
+    });
     set_watchdog_reload(reload);
     MAINTENANCE.fetch_add(1, Ordering::Relaxed);
     result

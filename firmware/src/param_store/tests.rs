@@ -3,9 +3,11 @@
 //! word of the record, inside the commit word) must leave the previous table loadable;
 //! corrupt, other-version and out-of-bounds records fall back to the defaults with the
 //! fault. Records for the layout tests are built here from the module's table, not with
-//! the module's encoder.
+//! the module's encoder. A save carries the torque feed-forward's table too: a cut leaves
+//! the previous parameters *and* the previous table.
 
 use super::*;
+use crate::compensation::{record as comp_record, Table, BINS, CHANNELS};
 use crate::parameters::ParamId;
 use embedded_storage::nor_flash::{ErrorType, NorFlashError, NorFlashErrorKind, ReadNorFlash};
 use std::vec::Vec;
@@ -144,8 +146,43 @@ impl NorFlash for CutFlash {
     }
 }
 
+/// Erase pages per slot: the record and the feed-forward table need two.
+const SLOT_PAGES: usize = SPAN.div_ceil(PAGE);
+
 fn store(flash: CutFlash) -> ParamStore<CutFlash> {
-    store_in_slots(flash, 1)
+    store_in_slots(flash, SLOT_PAGES)
+}
+
+/// A feed-forward table that differs with `k`: a ramp in the constant channel.
+fn comp_table(k: i16) -> Table {
+    let mut raw = [[0i16; CHANNELS]; BINS];
+    for (b, r) in raw.iter_mut().enumerate() {
+        *r = [k * (b as i16 % 50), -k, 3 * k];
+    }
+    Table::from_raw([15, 40, 20], &raw).unwrap()
+}
+
+/// Saves `values` with the feed-forward table `t`.
+fn save_with(
+    s: &mut ParamStore<CutFlash>,
+    values: &[f32; COUNT],
+    t: &Table,
+) -> Result<u32, StoreError<FlashError>> {
+    s.save(values, comp_record::source(t))
+}
+
+/// Saves `values` with an empty feed-forward table.
+fn save(
+    s: &mut ParamStore<CutFlash>,
+    values: &[f32; COUNT],
+) -> Result<u32, StoreError<FlashError>> {
+    save_with(s, values, &Table::ZERO)
+}
+
+/// The feed-forward table of the record the last load took.
+fn loaded_table(s: &mut ParamStore<CutFlash>) -> Result<Table, comp_record::RecordError> {
+    let mut t = Table::ZERO;
+    comp_record::read(TABLE_LEN, |at, buf| s.read_table(at, buf), &mut t).map(|()| t)
 }
 
 /// The store on slots of `pages` erase pages each, A first, B right after it.
@@ -172,22 +209,36 @@ fn table(k: f32) -> [f32; COUNT] {
 /// new one from then on; a save after the cut always succeeds. Returns the number of cut
 /// points tried.
 fn cut_everywhere(before: &[[f32; COUNT]]) -> usize {
-    cut_everywhere_in(1, before)
+    cut_everywhere_in(SLOT_PAGES, before)
 }
 
-/// [`cut_everywhere`] on slots of `pages` erase pages each.
+/// [`cut_everywhere`] on slots of `pages` erase pages each. Save k carries the
+/// feed-forward table `comp_table(k)`; the cut save carries `comp_table(9)`.
 fn cut_everywhere_in(pages: usize, before: &[[f32; COUNT]]) -> usize {
     let mut base = store_in_slots(CutFlash::blank(2 * pages), pages);
-    for t in before {
-        base.save(t).unwrap();
+    for (k, t) in before.iter().enumerate() {
+        save_with(&mut base, t, &comp_table(k as i16 + 1)).unwrap();
     }
     let base_mem = base.into_inner().mem;
     let old = before.last().copied();
+    let old_table = (!before.is_empty()).then(|| comp_table(before.len() as i16));
     let new = table(9.0);
-    let total = pages * PAGE + RECORD_LEN + COMMIT_LEN;
-    for cut in 0..=total {
+    let total = pages * PAGE + RECORD_LEN + TABLE_LEN + COMMIT_LEN;
+    // Every cut in the erase and the first and last 64 bytes of each record, and every
+    // 7th byte between (the table's 3 KiB would take minutes byte by byte).
+    let cuts = (0..=total).filter(|c| {
+        let w = c.saturating_sub(pages * PAGE);
+        *c < pages * PAGE
+            || w < 64
+            || total - c < 64
+            || (w + 64 > TABLE_AT && w < TABLE_AT + 64)
+            || c % 7 == 0
+    });
+    let mut tried = 0;
+    for cut in cuts {
+        tried += 1;
         let mut s = store_in_slots(CutFlash::reboot(base_mem.clone(), Some(cut)), pages);
-        let result = s.save(&new);
+        let result = save_with(&mut s, &new, &comp_table(9));
         let mem = s.into_inner().mem;
         let mut rebooted = store_in_slots(CutFlash::reboot(mem.clone(), None), pages);
         let (values, outcome) = rebooted.load();
@@ -200,18 +251,20 @@ fn cut_everywhere_in(pages: usize, before: &[[f32; COUNT]]) -> usize {
             assert_eq!(values, old, "cut {cut}: {outcome:?}");
             if old.is_some() {
                 assert!(matches!(outcome, LoadOutcome::Loaded { .. }), "cut {cut}");
+                assert_eq!(loaded_table(&mut rebooted).ok(), old_table, "cut {cut}");
             }
         } else {
             assert!(result.is_ok(), "cut {cut}: {result:?}");
             assert_eq!(values, Some(new), "cut {cut}");
+            assert_eq!(loaded_table(&mut rebooted), Ok(comp_table(9)), "cut {cut}");
         }
         // The next save works whatever the cut left behind.
         let again = table(10.0);
-        rebooted.save(&again).unwrap();
+        save(&mut rebooted, &again).unwrap();
         assert_eq!(rebooted.load().0, Some(again), "save after cut {cut}");
     }
     println!(
-        "{} saves before: {} cut points (erase {} B, record {RECORD_LEN} B, commit {COMMIT_LEN} B), each reloads the previous table",
+        "{} saves before: {tried} of {} cut points (erase {} B, record {RECORD_LEN} B, table {TABLE_LEN} B, commit {COMMIT_LEN} B), each reloads the previous table",
         before.len(),
         total + 1,
         pages * PAGE
@@ -222,7 +275,10 @@ fn cut_everywhere_in(pages: usize, before: &[[f32; COUNT]]) -> usize {
 #[test]
 fn a_power_cut_anywhere_in_the_first_save_leaves_the_store_blank() {
     let n = cut_everywhere(&[]);
-    assert_eq!(n, PAGE + RECORD_LEN + COMMIT_LEN + 1);
+    assert_eq!(
+        n,
+        SLOT_PAGES * PAGE + RECORD_LEN + TABLE_LEN + COMMIT_LEN + 1
+    );
 }
 
 #[test]
@@ -238,28 +294,32 @@ fn a_power_cut_while_overwriting_the_older_page_leaves_the_newer_table() {
 }
 
 #[test]
-fn a_slot_of_several_pages_is_erased_whole_and_survives_a_cut_in_any_page() {
-    // A record that outgrows one page (a compensation table) takes more pages per slot:
-    // the save erases the whole slot, and a cut in its second page still leaves the
-    // previous table in the other slot.
-    let n = cut_everywhere_in(2, &[table(1.0), table(2.0)]);
-    assert_eq!(n, 2 * PAGE + RECORD_LEN + COMMIT_LEN + 1);
+fn a_slot_of_more_pages_is_erased_whole_and_survives_a_cut_in_any_page() {
+    // A slot longer than the record: the save erases the whole slot, and a cut in its
+    // last page still leaves the previous table in the other slot.
+    let n = cut_everywhere_in(SLOT_PAGES + 1, &[table(1.0), table(2.0)]);
+    assert_eq!(
+        n,
+        (SLOT_PAGES + 1) * PAGE + RECORD_LEN + TABLE_LEN + COMMIT_LEN + 1
+    );
 }
 
 #[test]
 fn the_newest_of_two_valid_records_wins_and_pages_alternate() {
-    let mut s = store(CutFlash::blank(2));
+    let mut s = store(CutFlash::blank(2 * SLOT_PAGES));
     assert_eq!(s.load(), (None, LoadOutcome::Blank));
     for k in 1..=5u32 {
         let t = table(k as f32);
-        assert_eq!(s.save(&t), Ok(k));
+        assert_eq!(save_with(&mut s, &t, &comp_table(k as i16)), Ok(k));
         assert_eq!(s.load(), (Some(t), LoadOutcome::Loaded { sequence: k }));
+        assert_eq!(loaded_table(&mut s), Ok(comp_table(k as i16)));
     }
-    // Sequence 5 went to page A (odd), 4 to page B.
+    // Sequence 5 went to slot A (odd), 4 to slot B.
     let mem = s.into_inner().mem;
+    let b = SLOT_PAGES * PAGE;
     assert_eq!(u32::from_le_bytes(mem[8..12].try_into().unwrap()), 5);
     assert_eq!(
-        u32::from_le_bytes(mem[PAGE + 8..PAGE + 12].try_into().unwrap()),
+        u32::from_le_bytes(mem[b + 8..b + 12].try_into().unwrap()),
         4
     );
 }
@@ -281,13 +341,30 @@ fn documented_record(version: u16, fingerprint: u32, sequence: u32, values: &[f3
     while r.len() % 8 != 0 {
         r.push(0xFF);
     }
+    r.extend_from_slice(&documented_empty_table());
     r.extend_from_slice(b"CMMT");
     r.extend_from_slice(&sequence.to_le_bytes());
     r
 }
 
+/// An all-zero feed-forward table's record from the layout documented in
+/// `compensation::record` (exponents 0), independently of its encoder.
+fn documented_empty_table() -> Vec<u8> {
+    let mut r = Vec::new();
+    r.extend_from_slice(b"EHCT");
+    r.extend_from_slice(&1u16.to_le_bytes());
+    r.extend_from_slice(&512u16.to_le_bytes());
+    r.push(3);
+    r.extend_from_slice(&[0; 7]);
+    r.extend_from_slice(&[0; 512 * 6]);
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(&r);
+    r.extend_from_slice(&crc.to_le_bytes());
+    r.extend_from_slice(&[0xFF; 4]);
+    r
+}
+
 fn flash_with(page_a: &[u8]) -> CutFlash {
-    let mut f = CutFlash::blank(2);
+    let mut f = CutFlash::blank(2 * SLOT_PAGES);
     f.mem[..page_a.len()].copy_from_slice(page_a);
     f
 }
@@ -301,15 +378,15 @@ fn the_crc_is_crc32_iso_hdlc() {
 #[test]
 fn a_record_written_to_the_documented_layout_loads() {
     let t = table(3.0);
-    let rec = documented_record(1, parameters::LAYOUT_FINGERPRINT, 7, &t);
+    let rec = documented_record(2, parameters::LAYOUT_FINGERPRINT, 7, &t);
     assert_eq!(rec.len(), SPAN);
     let mut s = store(flash_with(&rec));
     assert_eq!(s.load(), (Some(t), LoadOutcome::Loaded { sequence: 7 }));
     // And the store writes exactly that layout.
-    let mut w = store(CutFlash::blank(2));
-    w.save(&t).unwrap();
+    let mut w = store(CutFlash::blank(2 * SLOT_PAGES));
+    save(&mut w, &t).unwrap();
     let mem = w.into_inner().mem;
-    let rec1 = documented_record(1, parameters::LAYOUT_FINGERPRINT, 1, &t);
+    let rec1 = documented_record(2, parameters::LAYOUT_FINGERPRINT, 1, &t);
     assert_eq!(&mem[..SPAN], &rec1[..]);
 }
 
@@ -318,13 +395,13 @@ fn the_save_after_the_last_sequence_number_wins() {
     // Found by fuzzing: a record at sequence u32::MAX; the save after it wraps to 0 and
     // used to lose to it ("newer = larger"), so the saved table vanished at the next boot.
     let old = table(3.0);
-    let rec = documented_record(1, parameters::LAYOUT_FINGERPRINT, u32::MAX, &old);
+    let rec = documented_record(2, parameters::LAYOUT_FINGERPRINT, u32::MAX, &old);
     let mut s = store(flash_with(&rec));
     let new = table(4.0);
-    assert_eq!(s.save(&new), Ok(0));
+    assert_eq!(save(&mut s, &new), Ok(0));
     assert_eq!(s.load(), (Some(new), LoadOutcome::Loaded { sequence: 0 }));
     let newer = table(5.0);
-    assert_eq!(s.save(&newer), Ok(1));
+    assert_eq!(save(&mut s, &newer), Ok(1));
     assert_eq!(s.load(), (Some(newer), LoadOutcome::Loaded { sequence: 1 }));
 }
 
@@ -341,11 +418,11 @@ fn a_corrupt_record_gives_the_defaults_and_the_fault() {
     let t = table(3.0);
     let fp = parameters::LAYOUT_FINGERPRINT;
     // One flipped bit in a value: the CRC no longer matches.
-    let mut rec = documented_record(1, fp, 1, &t);
+    let mut rec = documented_record(2, fp, 1, &t);
     rec[20] ^= 0x01;
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
     // A record without its commit word (cut between record and commit).
-    let mut rec = documented_record(1, fp, 1, &t);
+    let mut rec = documented_record(2, fp, 1, &t);
     let n = rec.len();
     rec[n - 8..].fill(0xFF);
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
@@ -357,12 +434,13 @@ fn a_corrupt_record_gives_the_defaults_and_the_fault() {
 fn an_old_version_or_another_table_gives_the_defaults_and_the_fault() {
     let t = table(3.0);
     let fp = parameters::LAYOUT_FINGERPRINT;
-    let rec = documented_record(0, fp, 1, &t);
+    // Version 1: the layout before the feed-forward table.
+    let rec = documented_record(1, fp, 1, &t);
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::OtherVersion);
-    let rec = documented_record(1, fp ^ 1, 1, &t);
+    let rec = documented_record(2, fp ^ 1, 1, &t);
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::OtherVersion);
     // A shorter table of an older firmware.
-    let rec = documented_record(1, fp, 1, &t[..COUNT - 1]);
+    let rec = documented_record(2, fp, 1, &t[..COUNT - 1]);
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::OtherVersion);
 }
 
@@ -371,22 +449,22 @@ fn stored_values_out_of_bounds_or_inconsistent_give_the_defaults_and_the_fault()
     let fp = parameters::LAYOUT_FINGERPRINT;
     let mut t = table(3.0);
     t[0] = 1e6; // current.kp_d above 200 V/A, CRC valid
-    let rec = documented_record(1, fp, 1, &t);
+    let rec = documented_record(2, fp, 1, &t);
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
     let mut t = table(3.0);
     t[0] = f32::NAN;
-    let rec = documented_record(1, fp, 1, &t);
+    let rec = documented_record(2, fp, 1, &t);
     boots_to_defaults_with_fault(flash_with(&rec), LoadOutcome::Corrupt);
 }
 
 #[test]
 fn a_blank_store_boots_the_defaults_without_a_fault_and_a_valid_one_its_table() {
-    let mut s = store(CutFlash::blank(2));
+    let mut s = store(CutFlash::blank(2 * SLOT_PAGES));
     let (cfg, outcome) = boot_config(&mut s, &Config::nominal());
     assert_eq!((cfg, outcome), (Config::nominal(), BootOutcome::Defaults));
     assert!(!outcome.is_fault());
     let t = table(4.0);
-    s.save(&t).unwrap();
+    save(&mut s, &t).unwrap();
     let (cfg, outcome) = boot_config(&mut s, &Config::nominal());
     assert_eq!(outcome, BootOutcome::Stored { sequence: 1 });
     assert_eq!(cfg.speed.kp, 0.14 + 0.01 * 4.0);
@@ -396,11 +474,11 @@ fn a_blank_store_boots_the_defaults_without_a_fault_and_a_valid_one_its_table() 
 
 #[test]
 fn a_corrupt_newer_page_falls_back_to_the_older_valid_one_without_a_fault() {
-    let mut s = store(CutFlash::blank(2));
-    s.save(&table(1.0)).unwrap();
-    s.save(&table(2.0)).unwrap();
+    let mut s = store(CutFlash::blank(2 * SLOT_PAGES));
+    save(&mut s, &table(1.0)).unwrap();
+    save(&mut s, &table(2.0)).unwrap();
     let mut f = s.into_inner();
-    f.mem[PAGE + 40] ^= 0x80; // page B holds sequence 2
+    f.mem[SLOT_PAGES * PAGE + 40] ^= 0x80; // slot B holds sequence 2
     let mut s = store(f);
     assert_eq!(
         s.load(),
@@ -409,25 +487,51 @@ fn a_corrupt_newer_page_falls_back_to_the_older_valid_one_without_a_fault() {
 }
 
 #[test]
+fn a_corrupt_feed_forward_table_is_refused_alone() {
+    // One flipped bit in the table's values: the parameters still load, the table's CRC
+    // refuses it (the controller then runs uncompensated with fault 21).
+    let mut s = store(CutFlash::blank(2 * SLOT_PAGES));
+    save_with(&mut s, &table(1.0), &comp_table(4)).unwrap();
+    let mut f = s.into_inner();
+    f.mem[TABLE_AT + 100] ^= 0x04;
+    let mut s = store(f);
+    assert_eq!(
+        s.load(),
+        (Some(table(1.0)), LoadOutcome::Loaded { sequence: 1 })
+    );
+    assert!(matches!(
+        loaded_table(&mut s),
+        Err(comp_record::RecordError::Crc { .. })
+    ));
+    // Nothing loaded yet: no table to read.
+    let mut blank = store(CutFlash::blank(2 * SLOT_PAGES));
+    let mut buf = [0u8; 8];
+    assert!(!blank.read_table(0, &mut buf));
+}
+
+#[test]
 fn misplaced_slots_are_refused() {
     let page = PAGE as u32;
+    let slot = SLOT_PAGES as u32 * page;
+    let pages = 2 * SLOT_PAGES;
     for (a, b, len, why) in [
-        (8, page, page, "not page-aligned"),
-        (0, 0, page, "the same slot"),
-        (0, 2 * page, page, "B past the end of a 2-page flash"),
-        (0, page, 2 * page, "overlapping two-page slots"),
-        (0, page, page + 8, "not a whole number of pages"),
-        (0, page, 0, "empty"),
-        (page, 0, u32::MAX, "past the address range"),
+        (8, slot, slot, "not page-aligned"),
+        (0, 0, slot, "the same slot"),
+        (0, 2 * slot, slot, "B past the end of the flash"),
+        (0, slot, 2 * slot, "overlapping slots"),
+        (0, slot, slot + 8, "not a whole number of pages"),
+        (0, slot, 0, "empty"),
+        (0, page, page, "shorter than a record"),
+        (slot, 0, u32::MAX, "past the address range"),
     ] {
         assert!(
             matches!(
-                ParamStore::new(CutFlash::blank(2), a, b, len),
+                ParamStore::new(CutFlash::blank(pages), a, b, len),
                 Err(StoreError::Layout)
             ),
             "{why}"
         );
     }
     // B before A is fine.
-    assert!(ParamStore::new(CutFlash::blank(2), page, 0, page).is_ok());
+    assert!(ParamStore::new(CutFlash::blank(pages), slot, 0, slot).is_ok());
 }

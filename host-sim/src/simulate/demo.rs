@@ -1,5 +1,6 @@
 //! `eha demo`: the paper's low-speed pressure holding in closed loop with and without the
-//! absorber, a pressure step and a speed step — a summary table, the runs' bench logs and
+//! absorber, each again with the torque feed-forward learned by the bench procedure
+//! (`crate::compensate`), a pressure step and a speed step — a summary table, the runs' bench logs and
 //! SVG plots in an output folder.
 
 use super::holding::pulsation;
@@ -11,6 +12,8 @@ use crate::pulsation::sources;
 use crate::run::{run, Run, RunOptions};
 use clap::Args;
 use closed_loop::{by_name, Scenario};
+use firmware::compensation::record::{Encoder, RECORD_LEN};
+use firmware::compensation::Table;
 use plant_model::effects::paper_low_speed_effects;
 use plant_model::{Effect, Rig};
 use rayon::prelude::*;
@@ -33,11 +36,13 @@ impl DemoArgs {
 }
 
 /// The files the demo writes into its folder (each figure an SVG and a PNG).
-const FILES: [&str; 12] = [
+const FILES: [&str; 14] = [
     "pressure-hold.csv",
     "pressure-hold-no-absorber.csv",
     "pressure-step.csv",
     "speed-step.csv",
+    "compensation-sweep.csv",
+    "compensation.table",
     "pressure_trace.svg",
     "pulsation_spectrum.svg",
     "pressure_step.svg",
@@ -48,8 +53,16 @@ const FILES: [&str; 12] = [
     "speed_step.png",
 ];
 
-/// A demo run: plant rig, controller rig, scenario, duration [s], log metadata.
-type Job<'a> = (&'a Rig, &'a Rig, &'a Scenario, f64, Vec<(String, String)>);
+/// A demo run: plant rig, controller rig, scenario, duration [s], log metadata, the torque
+/// feed-forward table loaded (if any).
+type Job<'a> = (
+    &'a Rig,
+    &'a Rig,
+    &'a Scenario,
+    f64,
+    Vec<(String, String)>,
+    Option<&'a Table>,
+);
 
 /// `eha demo`.
 pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
@@ -86,15 +99,43 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             ("absorber".into(), absorber.into()),
         ]
     };
-    // Three runs in parallel: holding with and without the absorber, and a pressure step.
+    // The torque feed-forward learned as a bench would: the drive's sweep and a 12 s hold
+    // at 5 MPa, `eha compensate`'s model method.
+    let (ff_table, ff_logs) = crate::compensate::study::bench_learning(rig, &plant, 12.0)?;
+    // In parallel: holding with and without the absorber, each without and with the
+    // feed-forward, a pressure step and a speed step.
     let jobs: Vec<Job> = vec![
-        (&plant, rig, hold, 4.0, meta("pressure-hold", "fitted")),
+        (
+            &plant,
+            rig,
+            hold,
+            4.0,
+            meta("pressure-hold", "fitted"),
+            None,
+        ),
         (
             &bare,
             &bare_controller,
             hold,
             4.0,
             meta("pressure-hold", "none"),
+            None,
+        ),
+        (
+            &plant,
+            rig,
+            hold,
+            4.0,
+            meta("pressure-hold", "fitted, feed-forward"),
+            Some(&ff_table),
+        ),
+        (
+            &bare,
+            &bare_controller,
+            hold,
+            4.0,
+            meta("pressure-hold", "none, feed-forward"),
+            Some(&ff_table),
         ),
         (
             &plant,
@@ -102,12 +143,20 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             step,
             step.duration_s,
             meta("pressure-step", "fitted"),
+            None,
         ),
-        (&plant, rig, speed_step, 0.4, meta("speed-step", "fitted")),
+        (
+            &plant,
+            rig,
+            speed_step,
+            0.4,
+            meta("speed-step", "fitted"),
+            None,
+        ),
     ];
     let runs: Vec<Result<Run, String>> = jobs
         .par_iter()
-        .map(|(p, c, sc, d, m)| {
+        .map(|(p, c, sc, d, m, table)| {
             run(
                 p,
                 c,
@@ -118,6 +167,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
                     seed: 1,
                     progress: false,
                     metadata: m.clone(),
+                    compensation: table.cloned(),
                 },
             )
         })
@@ -129,9 +179,21 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             .map_err(CliError::Failed)
             .and_then(converged)
     };
-    let (with, without, stepped, sped) = (next()?, next()?, next()?, next()?);
+    let (with, without) = (next()?, next()?);
+    let (with_ff, without_ff) = (next()?, next()?);
+    let (stepped, sped) = (next()?, next()?);
     let pw = pulsation(&with, hold, &plant);
     let po = pulsation(&without, hold, &plant);
+    let pwf = pulsation(&with_ff, hold, &plant);
+    let pof = pulsation(&without_ff, hold, &plant);
+    let mut record = [0u8; RECORD_LEN];
+    Encoder::write_all(&ff_table, &mut record);
+    let table_path = out.join("compensation.table");
+    crate::output::atomic::write(&table_path, &record).map_err(|source| CliError::Write {
+        file: table_path.clone(),
+        source,
+    })?;
+    write_log(&out.join("compensation-sweep.csv"), &ff_logs[0])?;
 
     let log_path = out.join("pressure-hold.csv");
     write_log(&log_path, &with.log)?;
@@ -155,12 +217,12 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         "cause (order per rev)",
         "shaft"
     );
+    let fitted = format!("fitted, p0 {:.1} MPa", rig.absorber.precharge_pa / 1e6);
     for (label, p) in [
-        (
-            format!("fitted, p0 {:.1} MPa", rig.absorber.precharge_pa / 1e6),
-            &pw,
-        ),
+        (fitted.clone(), &pw),
         ("none".to_string(), &po),
+        ("none + feed-forward".to_string(), &pof),
+        (format!("{fitted} + ff"), &pwf),
     ] {
         let cause = match p.cause {
             Some(s) => format!("{} ({:.0})", s.cause, s.order),
@@ -191,12 +253,21 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         "\nabsorption {absorption:.0} %; absorber natural frequency {:.1} Hz, damping ratio {:.2} at the holding pressure; {:.0}× real time",
         with.absorber_fn_hz, with.absorber_zeta, with.real_time_factor
     );
+    let cut =
+        |without: f64, with: f64| crate::compensate::predict::reduction_percent(without, with);
+    let _ = writeln!(
+        table,
+        "torque feed-forward (learned by the bench sweep and a 12 s hold, compensation.table): pulsation {:.0} % less without the absorber, {:.0} % less with it; the rest is the pump's flow ripple and the loop's wander (docs/compensation.md)",
+        cut(po.pp_pa, pof.pp_pa),
+        cut(pw.pp_pa, pwf.pp_pa)
+    );
 
     // Plots.
     pressure_figure(
         &out.join("pressure_trace.svg"),
         &with,
         &without,
+        &without_ff,
         hold.steady_from_s,
     )?;
     let plot = |name: &str, res: Result<(), String>| {
@@ -278,7 +349,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     speed_figure(&out.join("speed_step.svg"), &sped)?;
     let _ = writeln!(
         table,
-        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, pressure_trace, pulsation_spectrum, pressure_step, speed_step (each .svg and .png)",
+        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, compensation-sweep.csv (the feed-forward's bench sweep), compensation.table, pressure_trace, pulsation_spectrum, pressure_step, speed_step (each .svg and .png)",
         out.display()
     );
     print_stdout(&table)
@@ -297,6 +368,7 @@ fn pressure_figure(
     path: &Path,
     with: &Run,
     without: &Run,
+    without_ff: &Run,
     steady_from_s: f64,
 ) -> Result<(), CliError> {
     let t_end = with.log.t_s.last().copied().unwrap_or(0.0);
@@ -312,6 +384,10 @@ fn pressure_figure(
         Series {
             name: "true, no absorber",
             points: kpa_about_5mpa(&without.log.t_s, &without.p_true_pa),
+        },
+        Series {
+            name: "true, no absorber, torque feed-forward",
+            points: kpa_about_5mpa(&without_ff.log.t_s, &without_ff.p_true_pa),
         },
         Series {
             name: "true, absorber fitted",

@@ -69,6 +69,7 @@ pub(crate) fn holding_run(
             seed: 1,
             progress: true,
             metadata,
+            compensation: None,
         },
     )
     .map_err(CliError::Failed)

@@ -13,7 +13,7 @@ use crate::rig_file;
 use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
 use crate::values::{positive_f64, show};
 use clap::Args;
-use closed_loop::{by_name, SCENARIOS};
+use closed_loop::{by_name, PROCEDURES, SCENARIOS};
 use plant_model::effects::EFFECT_NAMES;
 use plant_model::{Effect, Rig};
 use serde_json::json;
@@ -50,6 +50,10 @@ pub struct SimulateArgs {
     /// Seed of the sensor noise.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// A torque feed-forward table written by `eha compensate`, loaded into the
+    /// controller and enabled before the run, as the drive loads it from flash.
+    #[arg(long, value_name = "TABLE")]
+    pub compensation: Option<PathBuf>,
     /// Log rate (a divisor of the 20 kHz PWM rate is logged exactly; typical bench logs
     /// are 1 kHz). [Hz]
     #[arg(long, value_name = "HZ", default_value = "2000", value_parser = log_rate, allow_negative_numbers = true)]
@@ -76,6 +80,7 @@ impl SimulateArgs {
     pub fn paths(&self) -> Declared<'_> {
         Declared::default()
             .input("--plant-rig", self.plant_rig.as_ref())
+            .input("--compensation", self.compensation.as_ref())
             .file("--out", self.out.as_ref())
             .file("--json", self.json.as_ref())
     }
@@ -205,10 +210,10 @@ pub(crate) fn write_log(path: &Path, log: &BenchLog) -> Result<(), CliError> {
 pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     if args.list {
         let mut s = String::new();
-        for sc in &SCENARIOS {
+        for sc in SCENARIOS.iter().chain(&PROCEDURES) {
             let _ = writeln!(
                 s,
-                "{:<15} {:>4.1} s  {}",
+                "{:<19} {:>4.1} s  {}",
                 sc.name, sc.duration_s, sc.description
             );
         }
@@ -216,7 +221,11 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     }
     let name = args.scenario.as_deref().unwrap_or_default();
     let scenario = by_name(name).ok_or_else(|| {
-        let names: Vec<&str> = SCENARIOS.iter().map(|s| s.name).collect();
+        let names: Vec<&str> = SCENARIOS
+            .iter()
+            .chain(&PROCEDURES)
+            .map(|s| s.name)
+            .collect();
         CliError::BadInput(format!(
             "unknown scenario `{name}`: the scenarios are {} (see `eha simulate --list`)",
             names.join(", ")
@@ -248,6 +257,10 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         Some(path) => plant_rig(&rig_file::load(path)?, &effects)?,
         None => plant_rig(&controller, &effects)?,
     };
+    let compensation = match &args.compensation {
+        Some(path) => Some(crate::compensate::read_table(path, &controller)?),
+        None => None,
+    };
     let duration = args.duration.unwrap_or(scenario.duration_s);
     let period_s = 1.0 / closed_loop::controller_config(&controller).rates.pwm_hz as f64;
     check_log_length(duration, args.log_rate, period_s)?;
@@ -266,6 +279,16 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     if let Some(path) = &args.plant_rig {
         metadata.push(("plant_rig".into(), path.display().to_string()));
     }
+    if let (Some(path), Some(t)) = (&args.compensation, &compensation) {
+        metadata.push((
+            "compensation".into(),
+            format!(
+                "{} (CRC {:#010x})",
+                path.display(),
+                firmware::compensation::record::crc_of(t)
+            ),
+        ));
+    }
     let r = run(
         &plant,
         &controller,
@@ -276,6 +299,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             seed,
             progress: true,
             metadata,
+            compensation,
         },
     )
     .map_err(CliError::Failed)

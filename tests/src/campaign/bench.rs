@@ -261,5 +261,19 @@ fn request_of(c: &Command) -> Option<Request> {
         Command::Commission => Some(Request::Commission),
         Command::SetParameter { id, value } => Some(Request::SetParameter { id, value }),
         Command::StepTest { .. } => None,
+        Command::CompensationHeader { exponents, bins } => {
+            Some(Request::CompensationHeader { exponents, bins })
+        }
+        Command::CompensationBin { bin, raw } => Some(Request::CompensationBin { bin, raw }),
+        Command::CompensationCommit { crc } => Some(Request::CompensationCommit { crc }),
+        Command::CompensationSweep { speed_rad_s, leg_s } => {
+            let ms = (leg_s * 1e3).round();
+            (0.0..=f32::from(u16::MAX))
+                .contains(&ms)
+                .then_some(Request::CompensationSweep {
+                    speed_rad_s,
+                    leg_ms: ms as u16,
+                })
+        }
     }
 }

@@ -106,7 +106,7 @@ impl Garbage {
             }
             1 => {
                 // An unused function base of the drive.
-                const UNUSED: [u16; 6] = [0x150, 0x160, 0x170, 0x250, 0x300, 0x7F0];
+                const UNUSED: [u16; 6] = [0x150, 0x160, 0x170, 0x280, 0x300, 0x7F0];
                 let base = UNUSED[(self.rng.next_u64() % 6) as usize];
                 (base | node, (self.rng.next_u64() % 9) as usize)
             }

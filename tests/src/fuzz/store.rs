@@ -1,19 +1,23 @@
-//! The stored-parameter record loader: two flash pages of arbitrary content (optionally
+//! The stored-parameter record loader: two flash slots of arbitrary content (optionally
 //! with a correct CRC and commit word, so the checks behind them are reached), booted into
-//! a configuration; what boots is a valid configuration, and a save on top of any content
-//! loads back exactly.
+//! a configuration and the torque feed-forward's table read from the loaded slot; what
+//! boots is a valid configuration with an accepted table or none, and a save on top of any
+//! content loads back exactly.
 
 use embedded_storage::nor_flash::{
     ErrorType, NorFlash, NorFlashError, NorFlashErrorKind, ReadNorFlash,
 };
+use firmware::compensation::record::source;
 use firmware::param_store::{
-    boot_config, LoadOutcome, ParamStore, COMMIT_LEN, COMMIT_MAGIC, CRC, RECORD_LEN, SPAN,
+    boot_config, LoadOutcome, ParamStore, COMMIT_AT, COMMIT_LEN, COMMIT_MAGIC, CRC, SPAN, TABLE_LEN,
 };
 use firmware::parameters::{self, COUNT};
-use firmware::Config;
+use firmware::{Config, Controller};
 
-/// Erase page of the RAM flash: big enough for a record and its commit word. [bytes]
+/// Erase page of the RAM flash. [bytes]
 const PAGE: usize = 256;
+/// A slot: whole pages holding a record, the feed-forward table and the commit word.
+const SLOT: usize = SPAN.div_ceil(PAGE) * PAGE;
 /// Programming unit (the G4's double word). [bytes]
 const WORD: usize = 8;
 /// Where the record's CRC sits (the documented layout: a 16-byte header, the values).
@@ -93,34 +97,44 @@ fn seal(page: &mut [u8]) {
     let crc = CRC.checksum(&page[..CRC_AT]);
     page[CRC_AT..CRC_AT + 4].copy_from_slice(&crc.to_le_bytes());
     let seq = [page[8], page[9], page[10], page[11]];
-    page[RECORD_LEN..RECORD_LEN + 4].copy_from_slice(&COMMIT_MAGIC.to_le_bytes());
-    page[RECORD_LEN + 4..RECORD_LEN + COMMIT_LEN].copy_from_slice(&seq);
+    page[COMMIT_AT..COMMIT_AT + 4].copy_from_slice(&COMMIT_MAGIC.to_le_bytes());
+    page[COMMIT_AT + 4..COMMIT_AT + COMMIT_LEN].copy_from_slice(&seq);
 }
 
-/// Two pages from `data` (first byte: bit 0/1 seal page A/B), booted, then a save of the
+/// Two slots from `data` (first byte: bit 0/1 seal slot A/B), booted, then a save of the
 /// booted table on top that must load back exactly.
 pub fn param_store(data: &[u8]) {
     let Some((&flags, data)) = data.split_first() else {
         return;
     };
-    let mut mem = vec![0xFF; 2 * PAGE];
+    let mut mem = vec![0xFF; 2 * SLOT];
     for (k, chunk) in data.chunks(SPAN).take(2).enumerate() {
-        let page = &mut mem[k * PAGE..k * PAGE + SPAN];
+        let page = &mut mem[k * SLOT..k * SLOT + SPAN];
         page[..chunk.len()].copy_from_slice(chunk);
         if flags >> k & 1 == 1 {
             seal(page);
         }
     }
     let mut store =
-        ParamStore::new(RamFlash(mem), 0, PAGE as u32, PAGE as u32).expect("the layout fits");
+        ParamStore::new(RamFlash(mem), 0, SLOT as u32, SLOT as u32).expect("the layout fits");
     let defaults = Config::nominal();
     let (config, outcome) = boot_config(&mut store, &defaults);
     assert!(
         config.validate().is_ok(),
         "booted an invalid configuration ({outcome:?})"
     );
+    // The feed-forward table of the loaded slot: accepted within its limit, or refused
+    // leaving none.
+    let mut controller = Controller::new(&config);
+    let read = |at: usize, buf: &mut [u8]| store.read_table(at, buf);
+    match controller.load_compensation_record(TABLE_LEN, read) {
+        Ok(()) => assert!(controller.compensation().amplitude_bound().is_finite()),
+        Err(_) => assert!(controller.compensation().table().is_zero()),
+    }
     let values = parameters::snapshot(&config);
-    let sequence = store.save(&values).expect("a save on RAM flash");
+    let sequence = store
+        .save(&values, source(controller.compensation().table()))
+        .expect("a save on RAM flash");
     match store.load() {
         (Some(v), LoadOutcome::Loaded { sequence: s }) => {
             assert_eq!(s, sequence);

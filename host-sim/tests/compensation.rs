@@ -1,0 +1,176 @@
+//! The torque feed-forward learned by the bench procedure and checked in closed loop, the
+//! firmware's control core against the plant: the effects put into the plant come back
+//! from the logs, and on the paper's holding at 5 MPa without the absorber the table takes
+//! at least 70 % off the shaft speed's pulsation (the issue's target; the pressure's is
+//! reported in `docs/compensation.md`). A table file of the wrong size or CRC is refused
+//! by `eha simulate --compensation` before any work, exit 2, naming the file; `eha
+//! compensate` refuses a log without the angle and an effect that is not angle-locked.
+
+mod common;
+
+use common::{eha, s};
+use host_sim::compensate::predict::{reduction_percent, without_and_with};
+use host_sim::compensate::study::{bench_learning, effects, with_effects};
+use host_sim::compensate::{find, Found};
+use plant_model::pump::kinematic_ripple_ratio;
+use plant_model::{Effect, Rig};
+use std::fs;
+
+fn learned(found: &Found, name: &str) -> Effect {
+    found
+        .effects
+        .iter()
+        .find(|l| l.effect.name() == name)
+        .unwrap_or_else(|| panic!("{name} not learned"))
+        .effect
+}
+
+#[test]
+fn the_bench_procedure_learns_the_effects_and_the_table_cuts_the_shaft_ripple() {
+    let rig = Rig::nominal();
+    // The paper's three effects at the nominal rig's values: cogging 0.05 N·m at 72/rev,
+    // flux harmonics 2 % of the torque, a 9-piston pump's kinematic ripple.
+    let plant = with_effects(&rig, &effects(1.0, 1.0, 0.0));
+    let (table, logs) = bench_learning(&rig, &plant, 12.0).expect("learned");
+    let found = find(&logs, &rig).expect("diagnosed");
+    match learned(&found, "cogging_torque") {
+        Effect::CoggingTorque {
+            amplitude_nm,
+            order,
+            phase_rad,
+        } => {
+            assert_eq!(order, 72);
+            assert!((amplitude_nm / 0.05 - 1.0).abs() < 0.2, "{amplitude_nm}");
+            assert!(phase_rad.abs() < 10f64.to_radians(), "{phase_rad}");
+        }
+        e => panic!("{e:?}"),
+    }
+    match learned(&found, "flux_harmonics") {
+        Effect::FluxHarmonics { t6_ratio, .. } => {
+            assert!((t6_ratio / 0.02 - 1.0).abs() < 0.2, "{t6_ratio}")
+        }
+        e => panic!("{e:?}"),
+    }
+    match learned(&found, "piston_ripple") {
+        Effect::PistonRipple {
+            pistons,
+            amplitude_ratio,
+        } => {
+            assert_eq!(pistons, 9);
+            let want = kinematic_ripple_ratio(9);
+            assert!(
+                (amplitude_ratio / want - 1.0).abs() < 0.2,
+                "{amplitude_ratio}"
+            );
+        }
+        e => panic!("{e:?}"),
+    }
+    // Holding without the absorber, where the shaft's ripple is what reaches the oil.
+    let bare = |r: &Rig| {
+        let mut r = r.clone();
+        r.absorber.enabled = false;
+        r
+    };
+    let (without, with) = without_and_with(&bare(&plant), &bare(&rig), &[&table]).expect("runs");
+    let with = with[0];
+    let cut = reduction_percent(without.speed_pp_rad_s, with.speed_pp_rad_s);
+    let locked = reduction_percent(without.speed_locked_pp_rad_s, with.speed_locked_pp_rad_s);
+    eprintln!(
+        "speed pp {:.3} -> {:.3} rad/s ({cut:.0} %), angle-locked {:.3} -> {:.3} ({locked:.0} %); \
+         pressure pp {:.0} -> {:.0} Pa",
+        without.speed_pp_rad_s,
+        with.speed_pp_rad_s,
+        without.speed_locked_pp_rad_s,
+        with.speed_locked_pp_rad_s,
+        without.pressure_pp_pa,
+        with.pressure_pp_pa
+    );
+    assert!(cut >= 70.0, "{cut} %");
+    assert!(locked >= 70.0, "{locked} %");
+    // And the pressure's angle-locked pulsation is less too (the pump's kinematic flow
+    // ripple, which no torque cancels, is most of what stays).
+    assert!(with.pressure_locked_pp_pa < without.pressure_locked_pp_pa);
+}
+
+#[test]
+fn a_table_file_of_the_wrong_size_or_crc_is_refused_naming_it() {
+    let dir = common::scratch("compensation", "bad-table");
+    // A valid record (all zero values) from the firmware's own encoder, then broken.
+    let mut good = [0u8; firmware::compensation::record::RECORD_LEN];
+    firmware::compensation::record::Encoder::write_all(
+        &firmware::compensation::Table::ZERO,
+        &mut good,
+    );
+    let short = dir.join("short.table");
+    fs::write(&short, &good[..good.len() - 1]).unwrap();
+    let crc = dir.join("crc.table");
+    let mut bad = good;
+    bad[100] ^= 0x40;
+    fs::write(&crc, bad).unwrap();
+    let out = dir.join("log.csv");
+    for (table, why) in [(&short, "3095 bytes"), (&crc, "CRC")] {
+        let o = eha(&[
+            "simulate",
+            "--scenario",
+            "pressure-hold",
+            "--compensation",
+            s(table),
+            "--out",
+            s(&out),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(s(table)), "{err}");
+        assert!(
+            err.to_lowercase().contains(&why.to_lowercase()),
+            "{why}: {err}"
+        );
+        assert!(!out.exists(), "nothing written");
+    }
+}
+
+#[test]
+fn eha_compensate_refuses_a_log_without_the_angle_and_an_unknown_effect() {
+    let dir = common::scratch("compensation", "bad-learning");
+    let log = dir.join("hold.csv");
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "1",
+        "--out",
+        s(&log),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut l = host_sim::bench_log::read(&log).unwrap();
+    l.theta_m_rad = None;
+    let blind = dir.join("no-angle.csv");
+    host_sim::bench_log::write(&blind, &l).unwrap();
+    let table = dir.join("t.table");
+    for (args, named) in [
+        (
+            vec!["compensate", s(&blind), "--out", s(&table)],
+            vec![s(&blind), "theta_m_rad"],
+        ),
+        (
+            vec![
+                "compensate",
+                s(&log),
+                "--out",
+                s(&table),
+                "--exclude",
+                "dead_time",
+            ],
+            vec!["--exclude", "dead_time", "cogging_torque"],
+        ),
+    ] {
+        let o = eha(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        for n in named {
+            assert!(err.contains(n), "{n}: {err}");
+        }
+        assert!(!table.exists(), "nothing written");
+    }
+}
