@@ -174,3 +174,50 @@ fn eha_compensate_refuses_a_log_without_the_angle_and_an_unknown_effect() {
         assert!(!table.exists(), "nothing written");
     }
 }
+
+/// `--can-log` writes the loading frames as a `candump -l` log: one line per frame,
+/// `(<seconds>.<micro>) can0 <id>#<payload>`, the same frames in the same order as the
+/// `cansend` lines printed (what `canplayer -I` replays onto the bus).
+#[test]
+fn eha_compensate_writes_the_frames_as_a_candump_log() {
+    let dir = common::scratch("compensation", "can-log");
+    let log = dir.join("hold.csv");
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "3",
+        "--out",
+        s(&log),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (table, dump) = (dir.join("t.table"), dir.join("load.log"));
+    let o = eha(&[
+        "compensate",
+        s(&log),
+        "--out",
+        s(&table),
+        "--can-log",
+        s(&dump),
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sent: Vec<&str> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("cansend can0 "))
+        .collect();
+    let dumped = fs::read_to_string(&dump).unwrap();
+    let frames: Vec<&str> = dumped
+        .lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(f.len(), 3, "{l}");
+            assert!(f[0].starts_with('(') && f[0].ends_with(')'), "{l}");
+            assert_eq!(f[1], "can0", "{l}");
+            f[2]
+        })
+        .collect();
+    assert!(!sent.is_empty());
+    assert_eq!(frames, sent);
+}

@@ -76,6 +76,9 @@ pub struct CompensateArgs {
     /// the pump delivers more and so evens out its flow.
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub exclude: Vec<String>,
+    /// Also write the loading frames as a `candump -l` log (`canplayer -I FILE` replays it).
+    #[arg(long, value_name = "FILE")]
+    pub can_log: Option<PathBuf>,
 }
 
 impl CompensateArgs {
@@ -87,6 +90,7 @@ impl CompensateArgs {
         }
         d.file("--out", Some(&self.out))
             .file("--json", self.json.as_ref())
+            .file("--can-log", self.can_log.as_ref())
     }
 }
 
@@ -354,6 +358,16 @@ pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> 
     );
     text.push_str(&can::cansend_lines(&frames));
     print_stdout(&text)?;
+    if let Some(path) = &args.can_log {
+        let commands: Vec<crate::can_commands::CanCommand> = frames
+            .iter()
+            .map(|f| crate::can_commands::CanCommand {
+                frame: *f,
+                what: "compensation table".into(),
+            })
+            .collect();
+        crate::can_commands::write_candump_log(path, &commands)?;
+    }
     if let Some(path) = &args.json {
         write_json(
             path,
