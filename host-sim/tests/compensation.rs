@@ -16,6 +16,22 @@ use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::{Effect, Rig};
 use std::fs;
 
+/// `eha simulate`'s pressure holding of `seconds` written to `dir/hold.csv`.
+fn hold_log(dir: &std::path::Path, seconds: &str) -> std::path::PathBuf {
+    let log = dir.join("hold.csv");
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        seconds,
+        "--out",
+        s(&log),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    log
+}
+
 fn learned(found: &Found, name: &str) -> Effect {
     found
         .effects
@@ -132,17 +148,7 @@ fn a_table_file_of_the_wrong_size_or_crc_is_refused_naming_it() {
 #[test]
 fn eha_compensate_refuses_a_log_without_the_angle_and_an_unknown_effect() {
     let dir = common::scratch("compensation", "bad-learning");
-    let log = dir.join("hold.csv");
-    let o = eha(&[
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
-        "1",
-        "--out",
-        s(&log),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let log = hold_log(&dir, "1");
     let mut l = host_sim::bench_log::read(&log).unwrap();
     l.theta_m_rad = None;
     let blind = dir.join("no-angle.csv");
@@ -181,17 +187,7 @@ fn eha_compensate_refuses_a_log_without_the_angle_and_an_unknown_effect() {
 #[test]
 fn eha_compensate_writes_the_frames_as_a_candump_log() {
     let dir = common::scratch("compensation", "can-log");
-    let log = dir.join("hold.csv");
-    let o = eha(&[
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
-        "3",
-        "--out",
-        s(&log),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let log = hold_log(&dir, "3");
     let (table, dump) = (dir.join("t.table"), dir.join("load.log"));
     let o = eha(&[
         "compensate",

@@ -103,6 +103,12 @@ impl Draw {
         self.effect.apply(&mut rig);
         rig
     }
+
+    /// The draw's scenario run on the plant `rig` under the draw's controller, with sensor
+    /// noise `noise_seed` ([`simulate`]).
+    pub fn run(&self, rig: &Rig, noise_seed: u64) -> Result<BenchLog, String> {
+        simulate(rig, &self.structure.controller, &self.scenario, noise_seed)
+    }
 }
 
 /// Uniform deviates from the generator's own xoshiro stream.
@@ -460,12 +466,7 @@ pub fn simulate(
 /// Generates the log of `seed` into `dir`: returns its path and the truth.
 pub fn generate(seed: u64, dir: &Path) -> Result<(PathBuf, Truth), String> {
     let d = draw(seed);
-    let mut log = simulate(
-        &d.truth_rig(),
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed,
-    )?;
+    let mut log = d.run(&d.truth_rig(), d.noise_seed)?;
     d.structure.drop_columns(&mut log);
     let path = dir.join(format!("blind-{:016x}.csv", d.token));
     bench_log::write(&path, &log).map_err(|e| e.to_string())?;

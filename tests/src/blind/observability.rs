@@ -4,7 +4,7 @@
 //! columns), the most any angle-locked model could gain on the log — the bound below which
 //! a log cannot tell the effect from `none`.
 
-use super::{simulate, Draw, BELOW_NOISE};
+use super::{Draw, BELOW_NOISE};
 use host_sim::bench_log::{BenchLog, Signal};
 use plant_model::pump::ripple_order;
 use plant_model::{Effect, Rig};
@@ -64,36 +64,11 @@ impl Signature {
 /// (the ADCs' and encoder's quantisation stay); the noise from two noisy effect-free runs
 /// with different noise seeds.
 pub fn signature(d: &Draw, signal: Signal, t_from: f64) -> Result<Signature, String> {
-    let with = simulate(
-        &noise_free(&d.truth_rig()),
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed,
-    )?;
-    let without = simulate(
-        &noise_free(&d.tolerance_rig),
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed,
-    )?;
-    let noisy = simulate(
-        &d.tolerance_rig,
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed,
-    )?;
-    let truth = simulate(
-        &d.truth_rig(),
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed,
-    )?;
-    let other = simulate(
-        &d.tolerance_rig,
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed ^ 0x9e37_79b9_7f4a_7c15,
-    )?;
+    let with = d.run(&noise_free(&d.truth_rig()), d.noise_seed)?;
+    let without = d.run(&noise_free(&d.tolerance_rig), d.noise_seed)?;
+    let noisy = d.run(&d.tolerance_rig, d.noise_seed)?;
+    let truth = d.run(&d.truth_rig(), d.noise_seed)?;
+    let other = d.run(&d.tolerance_rig, d.noise_seed ^ 0x9e37_79b9_7f4a_7c15)?;
     let col = |l: &BenchLog| -> Result<Vec<f64>, String> {
         l.column(signal)
             .map(<[f64]>::to_vec)
@@ -188,18 +163,8 @@ pub fn angle_locked_fit_bound(
     t_from: f64,
     orders: &[u32],
 ) -> Result<Vec<f64>, String> {
-    let truth = simulate(
-        &d.truth_rig(),
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed,
-    )?;
-    let perfect = simulate(
-        &noise_free(&d.tolerance_rig),
-        &d.structure.controller,
-        &d.scenario,
-        d.noise_seed,
-    )?;
+    let truth = d.run(&d.truth_rig(), d.noise_seed)?;
+    let perfect = d.run(&noise_free(&d.tolerance_rig), d.noise_seed)?;
     let theta = truth
         .theta_m_rad
         .as_deref()
