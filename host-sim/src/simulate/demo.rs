@@ -291,8 +291,8 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             "amplitude [Pa]",
             &[
                 Series {
-                    name: "absorber fitted",
-                    points: pw
+                    name: "no absorber",
+                    points: po
                         .spectrum
                         .iter()
                         .copied()
@@ -300,8 +300,8 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
                         .collect(),
                 },
                 Series {
-                    name: "no absorber",
-                    points: po
+                    name: "absorber fitted",
+                    points: pw
                         .spectrum
                         .iter()
                         .copied()
@@ -385,13 +385,15 @@ fn pressure_figure(
             name: "true, no absorber",
             points: kpa_about_5mpa(&without.log.t_s, &without.p_true_pa),
         },
-        Series {
-            name: "true, no absorber, torque feed-forward",
-            points: kpa_about_5mpa(&without_ff.log.t_s, &without_ff.p_true_pa),
-        },
+        // In the spectrum's order and colours: no absorber, absorber fitted, then the
+        // feed-forward's run.
         Series {
             name: "true, absorber fitted",
             points: kpa_about_5mpa(&with.log.t_s, &with.p_true_pa),
+        },
+        Series {
+            name: "true, no absorber, torque feed-forward",
+            points: kpa_about_5mpa(&without_ff.log.t_s, &without_ff.p_true_pa),
         },
     ];
     let measured = [Series {
