@@ -229,9 +229,15 @@ impl Hydraulics {
         let n = rows.len();
         let mut a = vec![0.0; n];
         let mut b = vec![0.0; n];
-        self.simulate_window(x, rows.clone(), guess, s_true, slope / gain, &mut a);
         let delta = 1e3;
-        self.simulate_window(x, rows.clone(), guess + delta, s_true, slope / gain, &mut b);
+        self.simulate_window(
+            x,
+            rows.clone(),
+            [guess, guess + delta],
+            s_true,
+            slope / gain,
+            [&mut a, &mut b],
+        );
         let (mut num, mut den) = (0.0, 0.0);
         for i in 1..n {
             let g = (b[i] - a[i]) / delta;
@@ -244,43 +250,42 @@ impl Hydraulics {
         }
     }
 
-    /// The measured pressure over `rows` from true pressure `p0` and transducer state
-    /// `s0` at the first row, the pressure rising at `slope` there, into `out` (row i of
-    /// the window at index i).
-    fn simulate_window(
+    /// The measured pressure over `rows` from each of the true pressures `p0` and
+    /// transducer state `s0` at the first row, the pressure rising at `slope` there, into
+    /// the matching `out` (row i of the window at index i). The runs share the inputs'
+    /// work (pump flow, volume, transducer factor) and step side by side.
+    fn simulate_window<const N: usize>(
         &self,
         x: &HydraulicInputs<'_>,
         rows: Range<usize>,
-        p0: f64,
+        p0: [f64; N],
         s0: f64,
         slope: f64,
-        out: &mut [f64],
+        out: [&mut [f64]; N],
     ) {
         let hp = &self.params;
-        let (v0, q0) = match &hp.absorber {
-            Some(g) => (g.oil_volume_m3(p0), g.capacitance_m3_per_pa(p0) * slope),
-            None => (0.0, 0.0),
-        };
-        let g0 = match &hp.absorber {
-            Some(g) if v0 > 0.0 => g.pressure_pa(v0) + ATMOSPHERE_PA,
-            Some(g) => g.precharge_abs_pa(),
-            None => ATMOSPHERE_PA,
-        };
-        let mut st = State {
-            p: p0,
-            q: q0,
-            v: v0,
-            g: g0,
-            s: s0,
-        };
+        let mut st = p0.map(|p0| self.start_state(p0, s0, slope));
         let ripple = hp.ripple.1 > 0.0;
         let gain = hp.sensor_gain;
-        out[0] = gain * st.s + hp.sensor_offset_pa;
+        let mut out = out;
+        for (o, st) in out.iter_mut().zip(&st) {
+            o[0] = gain * st.s + hp.sensor_offset_pa;
+        }
         let per_rad = hp.displacement_m3_per_rev / (2.0 * PI);
+        // The transducer's step factor 1 − e^(−h/τ), recomputed only when h changes.
+        let mut lag = (f64::NAN, 1.0);
         for k in rows.start..rows.end - 1 {
             let dt = x.t_s[k + 1] - x.t_s[k];
             let steps = ((dt / MAX_SUBSTEP_S).ceil() as usize).max(1);
             let h = dt / steps as f64;
+            if h != lag.0 {
+                let f = if hp.sensor_lag_s > 0.0 {
+                    1.0 - (-h / hp.sensor_lag_s).exp()
+                } else {
+                    1.0
+                };
+                lag = (h, f);
+            }
             let dtheta = x.theta_rad[k + 1] - x.theta_rad[k];
             let (x0, dx) = match x.x_m {
                 Some(xm) => (xm[k], xm[k + 1] - xm[k]),
@@ -298,15 +303,42 @@ impl Hydraulics {
                 let q_in = (per_rad * factor * dtheta - hp.area_m2 * dx) / dt;
                 let volume = hp.high_side_volume_m3 + hp.area_m2 * (x0 + f * dx);
                 let c_oil = volume.max(1e-9) / hp.bulk_modulus_pa;
-                self.substep(&mut st, h, q_in, p_low, c_oil);
+                for st in st.iter_mut() {
+                    self.substep(st, h, q_in, p_low, c_oil, lag.1);
+                }
             }
-            out[k + 1 - rows.start] = gain * st.s + hp.sensor_offset_pa;
+            for (o, st) in out.iter_mut().zip(&st) {
+                o[k + 1 - rows.start] = gain * st.s + hp.sensor_offset_pa;
+            }
         }
     }
 
-    /// One backward-Euler substep of length `h` with inflow `q_in`, see the module docs.
+    /// The node at a window's start: true pressure `p0`, transducer at `s0`, the absorber
+    /// in equilibrium with `p0` and filling at the pressure's `slope`.
+    fn start_state(&self, p0: f64, s0: f64, slope: f64) -> State {
+        let hp = &self.params;
+        let (v0, q0) = match &hp.absorber {
+            Some(g) => (g.oil_volume_m3(p0), g.capacitance_m3_per_pa(p0) * slope),
+            None => (0.0, 0.0),
+        };
+        let g0 = match &hp.absorber {
+            Some(g) if v0 > 0.0 => g.pressure_pa(v0) + ATMOSPHERE_PA,
+            Some(g) => g.precharge_abs_pa(),
+            None => ATMOSPHERE_PA,
+        };
+        State {
+            p: p0,
+            q: q0,
+            v: v0,
+            g: g0,
+            s: s0,
+        }
+    }
+
+    /// One backward-Euler substep of length `h` with inflow `q_in`, see the module docs;
+    /// `lag` is the transducer's step factor 1 − e^(−h/τ).
     #[inline]
-    fn substep(&self, st: &mut State, h: f64, q_in: f64, p_low: f64, c_oil: f64) {
+    fn substep(&self, st: &mut State, h: f64, q_in: f64, p_low: f64, c_oil: f64, lag: f64) {
         let hp = &self.params;
         let g = hp.leakage_m3_s_pa;
         let rhs = c_oil * st.p + h * q_in + h * g * p_low;
@@ -340,11 +372,7 @@ impl Hydraulics {
             }
         }
         st.p = p_new;
-        st.s = if hp.sensor_lag_s > 0.0 {
-            st.s + (st.p - st.s) * (1.0 - (-h / hp.sensor_lag_s).exp())
-        } else {
-            st.p
-        };
+        st.s += (st.p - st.s) * lag;
     }
 }
 
@@ -368,10 +396,10 @@ mod tests {
         Hydraulics::new(hp.clone(), &Rig::nominal()).simulate_window(
             &inputs,
             0..n,
-            p0,
+            [p0],
             p0,
             0.0,
-            &mut out,
+            [&mut out],
         );
         out
     }
