@@ -81,53 +81,122 @@ fn line_orders(rig: &Rig) -> Vec<u32> {
     v
 }
 
+/// What the pipeline reports as it goes: one call per finished step, naming the step
+/// that follows, [`STEPS`] calls in all.
+pub trait Progress: Sync {
+    /// A step finished; `next` is the one under way.
+    fn step(&self, next: &'static str);
+}
+
+impl<F: Fn(&'static str) + Sync> Progress for F {
+    fn step(&self, next: &'static str) {
+        self(next)
+    }
+}
+
+/// `value`, once `progress` has been told the step that made it finished.
+fn reported<T>(progress: &dyn Progress, value: T, next: &'static str) -> T {
+    progress.step(next);
+    value
+}
+
+/// Steps [`analyse_reporting`] reports: the facts, four calibrations, the lines, four
+/// relations' tests, the lines' tests, the predictions and the evidence.
+pub const STEPS: u64 = 13;
+
 /// Runs the whole diagnosis.
 pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
-    log.check(Path::new("bench log being diagnosed"))?;
-    rig.validate()?;
-    // 1. Facts.
-    let facts = LogFacts::of(log, rig);
-    let motion = ShaftMotion::of(log, &facts);
-    let windows = |rows, length, signal: &[f64]| thinned(facts.windows(rows, length), signal);
-    let h_id = windows(facts.identification(), HYDRAULIC_WINDOW_S, &log.p_pa);
-    let h_val = windows(facts.validation(), HYDRAULIC_WINDOW_S, &log.p_pa);
-    let m_id = windows(
-        facts.identification(),
-        MECHANICAL_WINDOW_S,
-        &log.speed_rad_s,
-    );
-    let m_val = windows(facts.validation(), MECHANICAL_WINDOW_S, &log.speed_rad_s);
-    let hrel = HydraulicRelation {
-        log,
-        facts: &facts,
-        rig,
-    };
-    let orders = line_orders(rig);
-    let mrel = MechanicalRelation::new(log, &facts, &motion, rig, &orders);
-    let erel = ElectricalRelation::of(log, &facts, rig);
-    let crel = CylinderRelation::of(log, &facts, rig);
-    // 2. Calibration, every relation in parallel.
-    let ((hcal, mcal), (ecal, ccal)) = rayon::join(
-        || rayon::join(|| calibrate(&hrel, &h_id), || calibrate(&mrel, &m_id)),
+    analyse_reporting(log, rig, &|_: &'static str| {})
+}
+
+/// The log's windows and the parity relations it supports.
+struct Relations<'a> {
+    h_id: Vec<Range<usize>>,
+    h_val: Vec<Range<usize>>,
+    m_id: Vec<Range<usize>>,
+    m_val: Vec<Range<usize>>,
+    hydraulic: HydraulicRelation<'a>,
+    mechanical: MechanicalRelation<'a>,
+    electrical: Option<ElectricalRelation<'a>>,
+    cylinder: Option<CylinderRelation<'a>>,
+    orders: Vec<u32>,
+}
+
+impl<'a> Relations<'a> {
+    fn of(
+        log: &'a BenchLog,
+        facts: &'a LogFacts,
+        motion: &'a ShaftMotion,
+        rig: &'a Rig,
+    ) -> Relations<'a> {
+        let windows = |rows, length, signal: &[f64]| thinned(facts.windows(rows, length), signal);
+        let orders = line_orders(rig);
+        Relations {
+            h_id: windows(facts.identification(), HYDRAULIC_WINDOW_S, &log.p_pa),
+            h_val: windows(facts.validation(), HYDRAULIC_WINDOW_S, &log.p_pa),
+            m_id: windows(
+                facts.identification(),
+                MECHANICAL_WINDOW_S,
+                &log.speed_rad_s,
+            ),
+            m_val: windows(facts.validation(), MECHANICAL_WINDOW_S, &log.speed_rad_s),
+            hydraulic: HydraulicRelation { log, facts, rig },
+            mechanical: MechanicalRelation::new(log, facts, motion, rig, &orders),
+            electrical: ElectricalRelation::of(log, facts, rig),
+            cylinder: CylinderRelation::of(log, facts, rig),
+            orders,
+        }
+    }
+}
+
+/// Each relation's baseline, fitted within the tolerance bands.
+struct Calibrations {
+    hydraulic: Calibration,
+    mechanical: Calibration,
+    electrical: Option<Calibration>,
+    cylinder: Option<Calibration>,
+}
+
+/// Stage 2: every relation calibrated, in parallel.
+fn calibrate_all(r: &Relations<'_>, progress: &dyn Progress) -> Calibrations {
+    let done = |c, next| reported(progress, c, next);
+    let ((hydraulic, mechanical), (electrical, cylinder)) = rayon::join(
         || {
             rayon::join(
-                || erel.as_ref().map(|r| calibrate(r, &m_id)),
-                || crel.as_ref().map(|r| calibrate(r, &m_id)),
+                || done(calibrate(&r.hydraulic, &r.h_id), "calibration"),
+                || done(calibrate(&r.mechanical, &r.m_id), "calibration"),
+            )
+        },
+        || {
+            rayon::join(
+                || {
+                    let c = r.electrical.as_ref().map(|e| calibrate(e, &r.m_id));
+                    reported(progress, c, "calibration")
+                },
+                || {
+                    let c = r.cylinder.as_ref().map(|c| calibrate(c, &r.m_id));
+                    reported(progress, c, "calibration")
+                },
             )
         },
     );
-    // 3. Lines, read with the calibrated shaft.
-    let mv = &mcal.fitted.values;
-    let shaft = ShaftConstants {
-        kt: 1.5 * rig.motor.pole_pairs as f64 * mv[mech::PSI],
-        j: mv[mech::INERTIA],
-        d_per_rad: mv[mech::DISPLACEMENT] / (2.0 * std::f64::consts::PI),
-    };
-    let lines = window_lines(log, &facts, &orders, shaft.kt, shaft.j, shaft.d_per_rad);
-    let (line_id, line_val): (Vec<_>, Vec<_>) = lines
-        .iter()
-        .partition(|w| w.window.rows.start < facts.split);
-    // 4. Every effect tested.
+    Calibrations {
+        hydraulic,
+        mechanical,
+        electrical,
+        cylinder,
+    }
+}
+
+/// Stage 4: every effect tested on its relation, in parallel, each with its released
+/// parameters.
+fn test_relations(
+    r: &Relations<'_>,
+    cal: &Calibrations,
+    facts: &LogFacts,
+    rig: &Rig,
+    progress: &dyn Progress,
+) -> Vec<Tested> {
     let mut hyd_releases = vec![Release::Leakage, Release::BulkModulus, Release::SensorLag];
     if rig.absorber.enabled {
         hyd_releases.push(Release::Precharge);
@@ -137,26 +206,39 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     if facts.piston_unseen {
         hyd_releases.clear();
     }
+    let (h, m) = (&cal.hydraulic, &cal.mechanical);
     let ((mut tested, mech_tests), (elec_tests, cyl_tests)) = rayon::join(
         || {
             rayon::join(
-                || test_relation(&hrel, &hcal, &h_id, &h_val, &hyd_releases, rig),
-                || test_relation(&mrel, &mcal, &m_id, &m_val, &[Release::ShaftFriction], rig),
+                || {
+                    let t = test_relation(&r.hydraulic, h, &r.h_id, &r.h_val, &hyd_releases, rig);
+                    reported(progress, t, "testing effects")
+                },
+                || {
+                    let rel = [Release::ShaftFriction];
+                    let t = test_relation(&r.mechanical, m, &r.m_id, &r.m_val, &rel, rig);
+                    reported(progress, t, "testing effects")
+                },
             )
         },
         || {
             rayon::join(
-                || match (&erel, &ecal) {
-                    (Some(r), Some(c)) => {
-                        test_relation(r, c, &m_id, &m_val, &[Release::DeadTime], rig)
-                    }
-                    _ => Vec::new(),
+                || {
+                    let t = match (&r.electrical, &cal.electrical) {
+                        (Some(e), Some(c)) => {
+                            test_relation(e, c, &r.m_id, &r.m_val, &[Release::DeadTime], rig)
+                        }
+                        _ => Vec::new(),
+                    };
+                    reported(progress, t, "testing effects")
                 },
-                || match (&crel, &ccal) {
-                    (Some(r), Some(c)) => {
-                        test_relation(r, c, &m_id, &m_val, &[Release::CylinderFriction], rig)
-                    }
-                    _ => Vec::new(),
+                || {
+                    let rel = [Release::CylinderFriction];
+                    let t = match (&r.cylinder, &cal.cylinder) {
+                        (Some(y), Some(c)) => test_relation(y, c, &r.m_id, &r.m_val, &rel, rig),
+                        _ => Vec::new(),
+                    };
+                    reported(progress, t, "testing effects")
                 },
             )
         },
@@ -164,20 +246,54 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     tested.extend(mech_tests);
     tested.extend(elec_tests);
     tested.extend(cyl_tests);
+    tested
+}
+
+/// Runs the whole diagnosis, reporting each finished step to `progress`.
+pub fn analyse_reporting(
+    log: &BenchLog,
+    rig: &Rig,
+    progress: &dyn Progress,
+) -> Result<Analysis, DiagnoseError> {
+    log.check(Path::new("bench log being diagnosed"))?;
+    rig.validate()?;
+    // 1. Facts.
+    let facts = LogFacts::of(log, rig);
+    let motion = ShaftMotion::of(log, &facts);
+    let rel = Relations::of(log, &facts, &motion, rig);
+    progress.step("calibration");
+    // 2. Calibration.
+    let cal = calibrate_all(&rel, progress);
+    // 3. Lines, read with the calibrated shaft.
+    let mv = &cal.mechanical.fitted.values;
+    let shaft = ShaftConstants {
+        kt: 1.5 * rig.motor.pole_pairs as f64 * mv[mech::PSI],
+        j: mv[mech::INERTIA],
+        d_per_rad: mv[mech::DISPLACEMENT] / (2.0 * std::f64::consts::PI),
+    };
+    let orders = &rel.orders;
+    let lines = window_lines(log, &facts, orders, shaft.kt, shaft.j, shaft.d_per_rad);
+    let (line_id, line_val): (Vec<_>, Vec<_>) = lines
+        .iter()
+        .partition(|w| w.window.rows.start < facts.split);
+    progress.step("testing effects");
+    // 4. Every effect tested.
+    let mut tested = test_relations(&rel, &cal, &facts, rig, progress);
     let mut line_tests = test_lines(
         &line_id,
         &line_val,
         rig,
         shaft,
-        &orders,
+        orders,
         &[rig.motor.cogging_fundamental_order()],
         facts.angle_logged,
     );
     // With the voltages logged the electrical relation reads the dead time directly.
-    if erel.is_some() {
+    if rel.electrical.is_some() {
         line_tests.retain(|t| t.effect != "dead_time");
     }
     tested.extend(line_tests);
+    progress.step("predictions");
     // 5. Decision.
     apply_vetoes(&mut tested);
     let named = decide(&tested);
@@ -187,15 +303,15 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         facts: &facts,
         motion: &motion,
         rig,
-        electrical: erel.as_ref(),
-        cylinder: crel.as_ref(),
+        electrical: rel.electrical.as_ref(),
+        cylinder: rel.cylinder.as_ref(),
     };
     let base_values = ModelValues {
-        hydraulic: hcal.fitted.values.clone(),
-        mechanical: mcal.fitted.values.clone(),
+        hydraulic: cal.hydraulic.fitted.values.clone(),
+        mechanical: cal.mechanical.fitted.values.clone(),
         lines: Vec::new(),
-        electrical: ecal.as_ref().map(|c| c.fitted.values.clone()),
-        cylinder: ccal.as_ref().map(|c| c.fitted.values.clone()),
+        electrical: cal.electrical.as_ref().map(|c| c.fitted.values.clone()),
+        cylinder: cal.cylinder.as_ref().map(|c| c.fitted.values.clone()),
         pressure_from_cylinder: named
             .is_some_and(|i| matches!(tested[i].extension, Extension::Cylinder(_))),
     };
@@ -208,10 +324,29 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         Some(_) => predict(&ctx, &ext_values),
         None => baseline.clone(),
     };
+    progress.step("evidence");
+    let a = assemble(log, &facts, &rel, &cal, tested, named, baseline, extended);
+    progress.step("done");
+    Ok(a)
+}
+
+/// Stages 6 and 7: the scores on the validation segment, the evidence for the report and
+/// the contract's result.
+#[allow(clippy::too_many_arguments)]
+fn assemble(
+    log: &BenchLog,
+    facts: &LogFacts,
+    rel: &Relations<'_>,
+    cal: &Calibrations,
+    tested: Vec<Tested>,
+    named: Option<usize>,
+    baseline: BTreeMap<&'static str, Vec<f64>>,
+    extended: BTreeMap<&'static str, Vec<f64>>,
+) -> Analysis {
+    let rig = rel.hydraulic.rig;
     let val = facts.validation();
-    let base_fit = fit_of(log, &facts, &baseline, val.clone());
-    let ext_fit = fit_of(log, &facts, &extended, val.clone());
-    // 7. Evidence for the report.
+    let base_fit = fit_of(log, facts, &baseline, val.clone());
+    let ext_fit = fit_of(log, facts, &extended, val.clone());
     let measured: BTreeMap<&'static str, Vec<f64>> = baseline
         .keys()
         .filter_map(|k| {
@@ -219,7 +354,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             Some((*k, log.column(s)?.to_vec()))
         })
         .collect();
-    let signatures = residual_signatures(log, &facts, &measured, &baseline);
+    let signatures = residual_signatures(log, facts, &measured, &baseline);
     let spectra = ["p_pa", "speed_rad_s", "iq_a"]
         .iter()
         .filter_map(|name| {
@@ -228,7 +363,8 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             Some((*name, order_spectrum(&facts.theta_rad, &r)?))
         })
         .collect();
-    let causes = causes(&tested, named, &calibration_summary(&hcal, &mcal, &facts));
+    let (hcal, mcal) = (&cal.hydraulic, &cal.mechanical);
+    let causes = causes(&tested, named, &calibration_summary(hcal, mcal, facts));
     let named_effect = named.map(|i| tested[i].effect.to_string());
     let mut order_idx: Vec<usize> = (0..tested.len()).collect();
     order_idx.sort_by(|a, b| rank_key(&tested, named, *b).total_cmp(&rank_key(&tested, named, *a)));
@@ -244,33 +380,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
             rmse_reduction_percent: 100.0 * (1.0 - ext_fit.rmse_pa / base_fit.rmse_pa),
         },
         causes,
-        calibration: [
-            ("hydraulic", Some((&hcal, hrel.specs(Release::Nothing)))),
-            ("mechanical", Some((&mcal, mrel.specs(Release::Nothing)))),
-            (
-                "electrical",
-                ecal.as_ref()
-                    .zip(erel.as_ref().map(|r| r.specs(Release::Nothing))),
-            ),
-            (
-                "cylinder",
-                ccal.as_ref()
-                    .zip(crel.as_ref().map(|r| r.specs(Release::Nothing))),
-            ),
-        ]
-        .into_iter()
-        .filter_map(|(name, c)| {
-            let (cal, specs) = c?;
-            Some((
-                name.to_string(),
-                specs
-                    .iter()
-                    .zip(&cal.fitted.values)
-                    .map(|(s, v)| (s.name.to_string(), *v))
-                    .collect(),
-            ))
-        })
-        .collect(),
+        calibration: calibration_values(rel, cal),
         extended: Extended {
             effects: named_effect.into_iter().collect(),
             fit_percent: ext_fit.fit_percent,
@@ -280,7 +390,7 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         },
         baseline: base_fit,
     };
-    Ok(Analysis {
+    Analysis {
         diagnosis,
         t_s: t.clone(),
         measured,
@@ -290,7 +400,49 @@ pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
         signatures,
         candidate_orders: candidate_orders(rig),
         tested,
+    }
+}
+
+/// Each relation's calibrated parameters by name, for the JSON.
+fn calibration_values(
+    rel: &Relations<'_>,
+    cal: &Calibrations,
+) -> BTreeMap<String, BTreeMap<String, f64>> {
+    [
+        (
+            "hydraulic",
+            Some((&cal.hydraulic, rel.hydraulic.specs(Release::Nothing))),
+        ),
+        (
+            "mechanical",
+            Some((&cal.mechanical, rel.mechanical.specs(Release::Nothing))),
+        ),
+        (
+            "electrical",
+            cal.electrical
+                .as_ref()
+                .zip(rel.electrical.as_ref().map(|r| r.specs(Release::Nothing))),
+        ),
+        (
+            "cylinder",
+            cal.cylinder
+                .as_ref()
+                .zip(rel.cylinder.as_ref().map(|r| r.specs(Release::Nothing))),
+        ),
+    ]
+    .into_iter()
+    .filter_map(|(name, c)| {
+        let (cal, specs) = c?;
+        Some((
+            name.to_string(),
+            specs
+                .iter()
+                .zip(&cal.fitted.values)
+                .map(|(s, v)| (s.name.to_string(), *v))
+                .collect(),
+        ))
     })
+    .collect()
 }
 
 /// The sort key that ranks the tested effects: the named one first, then by Λ over its

@@ -1,7 +1,7 @@
 //! `eha diagnose LOG.csv [--json PATH] [--report DIR]`: reads the log, diagnoses it against
 //! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
-use super::analysis::analyse;
+use super::analysis::{analyse_reporting, STEPS};
 use super::DiagnoseError;
 use crate::output::paths::Declared;
 use crate::output::{print_stdout, write_json, CliError};
@@ -61,13 +61,16 @@ fn input_or_failure(e: DiagnoseError, log: &std::path::Path) -> CliError {
 pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
     let log = crate::bench_log::read(&args.log)?;
     crate::bench_log::replayable::check(&log, rig, &args.log)?;
-    let busy = crate::output::progress::spinner(format!(
-        "diagnosing {} ({} rows)",
-        args.log.display(),
-        log.len()
-    ));
-    let analysis = analyse(&log, rig);
-    busy.finish_and_clear();
+    let bar = crate::output::progress::steps(
+        STEPS,
+        format!("diagnosing {} ({} rows)", args.log.display(), log.len()),
+    );
+    bar.set_prefix("facts");
+    let analysis = analyse_reporting(&log, rig, &|next: &'static str| {
+        bar.inc(1);
+        bar.set_prefix(next);
+    });
+    bar.finish_and_clear();
     let analysis = analysis.map_err(|e| input_or_failure(e, &args.log))?;
     let d = &analysis.diagnosis;
     let mut text = String::new();

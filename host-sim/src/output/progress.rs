@@ -15,3 +15,16 @@ pub fn spinner(message: String) -> ProgressBar {
     b.enable_steady_tick(Duration::from_millis(200));
     b
 }
+
+/// A bar of `steps` steps with `message`, the step under way and the elapsed time.
+pub fn steps(steps: u64, message: String) -> ProgressBar {
+    let b = ProgressBar::new(steps);
+    b.set_style(
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} {prefix} {elapsed}")
+            .map(|s| s.progress_chars("=> "))
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message(message);
+    b.enable_steady_tick(Duration::from_millis(200));
+    b
+}
