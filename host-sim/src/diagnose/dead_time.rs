@@ -28,6 +28,12 @@ use std::f64::consts::PI;
 /// Dead time the model's lines are computed for (they scale with it). [s]
 pub const REFERENCE_DEAD_TIME_S: f64 = 1e-6;
 
+/// Longest dead time a line is read as, as a fraction of the PWM period: gate drivers
+/// insert 0.1–3 µs, a few per cent of a 20 kHz period; lines that would need more are not
+/// a dead time's (at a light load, where the current stays inside the fade band, a small
+/// line divided by a vanishing model line would otherwise read as seconds). [1]
+pub const MAX_DEAD_TIME_PERIODS: f64 = 0.1;
+
 /// Current bands of the dead-time error's fade tried. [A]
 pub const BANDS_A: [f64; 7] = [0.01, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8];
 
@@ -111,33 +117,20 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
 /// Fits the dead time to the d and q current lines at order 6·p_n of `lines`.
 pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> Option<DeadTimeFit> {
     let mut best: Option<DeadTimeFit> = None;
+    let max_scale =
+        MAX_DEAD_TIME_PERIODS / rig.inverter.pwm_frequency_hz.max(1.0) / REFERENCE_DEAD_TIME_S;
     for band in BANDS_A {
         let obs = observations(lines, rig, band, candidates);
         if obs.is_empty() {
             return None;
         }
-        let (mut num, mut den, mut power) = (0.0, 0.0, 0.0);
-        for o in &obs {
-            for a in 0..2 {
-                num += o.measured[a] * o.model[a] / o.var[a];
-                den += o.model[a] * o.model[a] / o.var[a];
-                power += o.measured[a] * o.measured[a] / o.var[a];
-            }
-        }
-        if den <= 0.0 {
+        let Some((scale, lambda)) = solve(&obs, max_scale) else {
             continue;
-        }
-        let scale = (num / den).max(0.0);
-        let resid: f64 = obs
-            .iter()
-            .flat_map(|o| {
-                (0..2).map(move |a| (o.measured[a] - scale * o.model[a]).powi(2) / o.var[a])
-            })
-            .sum();
+        };
         let fit = DeadTimeFit {
             dead_time_s: scale * REFERENCE_DEAD_TIME_S,
             band_a: band,
-            lambda: (power - resid).max(0.0),
+            lambda,
             windows: obs.len(),
         };
         if best.as_ref().is_none_or(|b| fit.lambda > b.lambda) {
@@ -145,6 +138,32 @@ pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> O
         }
     }
     best
+}
+
+/// The weighted least-squares scale of the model lines onto the measured ones and the line
+/// power it explains; `None` when no model line is there or the scale would pass
+/// `max_scale`.
+fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64)> {
+    let (mut num, mut den, mut power) = (0.0, 0.0, 0.0);
+    for o in obs {
+        for a in 0..2 {
+            num += o.measured[a] * o.model[a] / o.var[a];
+            den += o.model[a] * o.model[a] / o.var[a];
+            power += o.measured[a] * o.measured[a] / o.var[a];
+        }
+    }
+    if den <= 0.0 {
+        return None;
+    }
+    let scale = (num / den).max(0.0);
+    if scale > max_scale {
+        return None;
+    }
+    let resid: f64 = obs
+        .iter()
+        .flat_map(|o| (0..2).map(move |a| (o.measured[a] - scale * o.model[a]).powi(2) / o.var[a]))
+        .sum();
+    Some((scale, (power - resid).max(0.0)))
 }
 
 /// The line power `fit` explains in the windows `lines`. [1]
@@ -184,6 +203,36 @@ mod tests {
         assert!((hd.norm() - 1.0 / c.ki_d as f64).abs() < 0.01 / c.ki_d as f64);
         let (hd, _) = disturbance_sensitivity(&rig, 1e6);
         assert!((hd.norm() * rig.motor.l_d_h * 1e6 - 1.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn lines_are_scaled_onto_the_model_and_refused_beyond_the_plausible_dead_time() {
+        // Two windows whose d and q lines are 3× the model's: a scale of 3, and all of the
+        // line power (9 + 9 + 36 + 36 noise units over unit variances) explained.
+        let obs = [
+            Obs {
+                measured: [3.0, 3.0],
+                model: [1.0, 1.0],
+                var: [1.0, 1.0],
+            },
+            Obs {
+                measured: [6.0, 6.0],
+                model: [2.0, 2.0],
+                var: [1.0, 1.0],
+            },
+        ];
+        let (scale, lambda) = solve(&obs, 10.0).unwrap();
+        assert!((scale - 3.0).abs() < 1e-12 && (lambda - 90.0).abs() < 1e-9);
+        // The same lines where the model has almost none: the scale would be 3·10⁶.
+        let faint = obs.map(|o| Obs {
+            model: [o.model[0] * 1e-6, o.model[1] * 1e-6],
+            ..o
+        });
+        assert!(solve(&faint, 10.0).is_none());
+        // At 20 kHz a tenth of the period is 5 µs: 5 references of 1 µs.
+        let rig = Rig::nominal();
+        let bound = MAX_DEAD_TIME_PERIODS / rig.inverter.pwm_frequency_hz / REFERENCE_DEAD_TIME_S;
+        assert!((bound - 5.0).abs() < 1e-9);
     }
 
     #[test]
