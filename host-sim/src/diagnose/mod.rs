@@ -37,6 +37,7 @@ pub mod lines;
 pub mod mechanical;
 pub mod predictions;
 pub mod report;
+pub mod result;
 pub mod signatures;
 pub mod spectrum;
 
