@@ -369,9 +369,12 @@ fn parse(b: &[u8; RECORD_LEN], commit: &[u8; COMMIT_LEN]) -> Page {
     {
         return Page::Corrupt;
     }
-    let mut values = ParamId::ALL.map(ParamId::default_value);
-    for (v, chunk) in values.iter_mut().zip(b[HEADER_LEN..crc_at].chunks_exact(4)) {
-        *v = f32::from_bits(u32_at(chunk, 0));
+    let mut values = [0f32; COUNT];
+    for (k, v) in values.iter_mut().enumerate() {
+        *v = match b.get(HEADER_LEN + 4 * k..).filter(|_| k < n) {
+            Some(chunk) => f32::from_bits(u32_at(chunk, 0)),
+            None => ParamId::ALL.get(k).map_or(0.0, |p| p.default_value()),
+        };
     }
     Page::Valid {
         sequence,

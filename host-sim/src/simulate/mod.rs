@@ -285,7 +285,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             format!(
                 "{} (CRC {:#010x})",
                 path.display(),
-                firmware::compensation::record::crc_of(t)
+                firmware::compensation::record::crc_of(&t.table)
             ),
         ));
     }
