@@ -393,9 +393,11 @@ impl Compensation {
         &self.flow
     }
 
-    /// The q-current feed-forward at shaft angle `theta_m` [rad] (in [0, 2π), the
+    /// The q-current feed-forward [A] at shaft angle `theta_m` [rad] (in [0, 2π), the
     /// encoder's), speed `omega` [rad/s], port-A pressure `p_pa` [Pa] and q-current
-    /// reference `iq_ref` [A]. [A]
+    /// reference `iq_ref` [A]; and the per-current channel g·c_i, the flux harmonics'
+    /// share of the magnet flux the current loop's decoupling takes for their back-EMF
+    /// ([`crate::current_loop`]). [1]
     ///
     /// The same cost whether it acts or not (a zero gain multiplies a finite table), so the
     /// step's worst case is its every case. The bin comes from the angle in bins, a
@@ -403,11 +405,12 @@ impl Compensation {
     /// conversion then floors, and the fraction is the float remainder (no fixed-point
     /// mask and scale as in [`crate::angle_grid`], three instructions fewer).
     #[inline(always)]
-    pub fn current(&self, theta_m: f32, omega: f32, p_pa: f32, iq_ref: f32) -> f32 {
+    pub fn current(&self, theta_m: f32, omega: f32, p_pa: f32, iq_ref: f32) -> (f32, f32) {
         let bins = BINS as f32 + theta_m * BINS_PER_RAD + omega * self.lead_bins;
         let whole = bins as i32;
         let [c0, cp, ci] = self.table.interpolate(whole as usize, bins - whole as f32);
-        self.gain * (c0 + cp * p_pa + ci * iq_ref)
+        let flux = self.gain * ci;
+        (self.gain * (c0 + cp * p_pa) + flux * iq_ref, flux)
     }
 
     /// The table in use (or being loaded).

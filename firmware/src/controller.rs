@@ -583,10 +583,11 @@ impl Controller {
         let mut bridge = mode.is_active();
         let mut conditions = Conditions::default();
         self.iq_ff = 0.0;
+        let mut flux_ripple = 0.0;
         match mode {
             Mode::Speed | Mode::Pressure => {
                 self.id_ref = 0.0;
-                self.iq_ff = self.compensation.current(
+                (self.iq_ff, flux_ripple) = self.compensation.current(
                     self.theta_m,
                     self.speed.speed(),
                     self.p_pa,
@@ -626,7 +627,7 @@ impl Controller {
             };
             match self.open_loop_voltage.take() {
                 Some(u) => self.current.apply_voltage(m, theta_e, u),
-                None => self.current.step(m, theta_e, i_ref, omega_e),
+                None => self.current.step(m, theta_e, i_ref, omega_e, flux_ripple),
             }
         } else {
             CurrentLoopState {

@@ -62,7 +62,7 @@
 
 use crate::compensation::record::{self as table_record, CHUNK_MAX};
 use crate::config::Config;
-use crate::parameters::{self, ParamId, COUNT, LEGACY_COUNT};
+use crate::parameters::{self, COUNT, LEGACY_COUNT};
 use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
 use embedded_storage::nor_flash::NorFlash;
 
@@ -373,7 +373,10 @@ fn parse(b: &[u8; RECORD_LEN], commit: &[u8; COMMIT_LEN]) -> Page {
     for (k, v) in values.iter_mut().enumerate() {
         *v = match b.get(HEADER_LEN + 4 * k..).filter(|_| k < n) {
             Some(chunk) => f32::from_bits(u32_at(chunk, 0)),
-            None => ParamId::ALL.get(k).map_or(0.0, |p| p.default_value()),
+            None => parameters::ADDED_DEFAULTS
+                .get(k.wrapping_sub(LEGACY_COUNT))
+                .copied()
+                .unwrap_or(0.0),
         };
     }
     Page::Valid {

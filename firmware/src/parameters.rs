@@ -85,6 +85,11 @@ pub const COUNT: usize = 39;
 /// their defaults.
 pub const LEGACY_COUNT: usize = 34;
 
+/// The defaults of the parameters after the first [`LEGACY_COUNT`] (ids 64–68, those of
+/// [`Config::nominal`]: a test holds them to it), as constants, so loading a legacy record
+/// links no configuration.
+pub const ADDED_DEFAULTS: [f32; COUNT - LEGACY_COUNT] = [0.0, 0.0, 0.0, 8.0e-4, 0.1];
+
 /// A parameter of the live table; the discriminant is the wire id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(u8)]

@@ -85,7 +85,7 @@ impl Controller {
             ParamId::CompensationMaxFlowRatio => (c.scale, c.flow_ratio, value),
             _ => return Ok(()),
         };
-        if !(scale * ratio > max) || id.check(value).is_err() {
+        if id.check(value).is_err() || scale * ratio <= max {
             return Ok(());
         }
         Err(match id {
