@@ -336,3 +336,67 @@ fn the_modulated_speed_makes_the_plants_pump_deliver_an_even_flow() {
         );
     }
 }
+
+/// A hold with a pump ripple 5 % peak-to-peak: `eha compensate` learns it into the table
+/// file's parameter trailer (record + 44 bytes), prints the frames that set ids 64–67
+/// before enabling, reports it in the JSON; `eha simulate --compensation` loads it.
+#[test]
+fn eha_compensate_carries_the_speed_modulation_in_the_table_file() {
+    let dir = common::scratch("compensation", "flow-trailer");
+    let log = dir.join("hold.csv");
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "8",
+        "--effects",
+        "piston_ripple:amplitude_ratio=0.05",
+        "--out",
+        s(&log),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (table, json) = (dir.join("t.table"), dir.join("t.json"));
+    let o = eha(&[
+        "compensate",
+        s(&log),
+        "--out",
+        s(&table),
+        "--json",
+        s(&json),
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let len = fs::metadata(&table).unwrap().len() as usize;
+    assert_eq!(len, firmware::compensation::record::RECORD_LEN + 12 + 8 * 4);
+    let j: serde_json::Value = serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(j["flow_ripple"]["pistons"], 9);
+    let ratio = j["flow_ripple"]["ratio"].as_f64().unwrap();
+    assert!((ratio / 0.05 - 1.0).abs() < 0.15, "{ratio}");
+    // SetParameter (0x200 + node) of ids 64..=67, then enabled (60 = 0x3C), then save.
+    let sets: Vec<&str> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("cansend can0 201#"))
+        .map(|p| &p[..2])
+        .collect();
+    assert_eq!(sets, ["40", "41", "42", "43", "3C"], "{out}");
+    let sim = dir.join("sim.csv");
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "1",
+        "--compensation",
+        s(&table),
+        "--out",
+        s(&sim),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let head = fs::read_to_string(&sim).unwrap();
+    assert!(
+        head.contains("speed modulation 9 pistons"),
+        "{}",
+        &head[..400]
+    );
+}
