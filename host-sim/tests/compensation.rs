@@ -21,10 +21,11 @@ use plant_model::pump::Pump;
 use plant_model::{Effect, Rig};
 use std::fs;
 
-/// `eha simulate`'s pressure holding of `seconds` written to `dir/hold.csv`.
-fn hold_log(dir: &std::path::Path, seconds: &str) -> std::path::PathBuf {
+/// `eha simulate`'s pressure holding of `seconds` written to `dir/hold.csv`, with the
+/// further arguments `extra`.
+fn hold_log(dir: &std::path::Path, seconds: &str, extra: &[&str]) -> std::path::PathBuf {
     let log = dir.join("hold.csv");
-    let o = eha(&[
+    let mut args = vec![
         "simulate",
         "--scenario",
         "pressure-hold",
@@ -32,9 +33,21 @@ fn hold_log(dir: &std::path::Path, seconds: &str) -> std::path::PathBuf {
         seconds,
         "--out",
         s(&log),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let o = eha(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     log
+}
+
+/// `eha compensate LOG --out TABLE` with the further arguments `extra`: its standard
+/// output (it must succeed).
+fn compensate(log: &std::path::Path, table: &std::path::Path, extra: &[&str]) -> String {
+    let mut args = vec!["compensate", s(log), "--out", s(table)];
+    args.extend_from_slice(extra);
+    let o = eha(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
 fn learned(found: &Found, name: &str) -> Effect {
@@ -194,7 +207,7 @@ fn a_table_file_of_the_wrong_size_or_crc_is_refused_naming_it() {
 #[test]
 fn eha_compensate_refuses_a_log_without_the_angle_and_an_unknown_effect() {
     let dir = common::scratch("compensation", "bad-learning");
-    let log = hold_log(&dir, "1");
+    let log = hold_log(&dir, "1", &[]);
     let mut l = host_sim::bench_log::read(&log).unwrap();
     l.theta_m_rad = None;
     let blind = dir.join("no-angle.csv");
@@ -233,18 +246,9 @@ fn eha_compensate_refuses_a_log_without_the_angle_and_an_unknown_effect() {
 #[test]
 fn eha_compensate_writes_the_frames_as_a_candump_log() {
     let dir = common::scratch("compensation", "can-log");
-    let log = hold_log(&dir, "3");
+    let log = hold_log(&dir, "3", &[]);
     let (table, dump) = (dir.join("t.table"), dir.join("load.log"));
-    let o = eha(&[
-        "compensate",
-        s(&log),
-        "--out",
-        s(&table),
-        "--can-log",
-        s(&dump),
-    ]);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = compensate(&log, &table, &["--can-log", s(&dump)]);
     let sent: Vec<&str> = out
         .lines()
         .filter_map(|l| l.strip_prefix("cansend can0 "))
@@ -343,30 +347,13 @@ fn the_modulated_speed_makes_the_plants_pump_deliver_an_even_flow() {
 #[test]
 fn eha_compensate_carries_the_speed_modulation_in_the_table_file() {
     let dir = common::scratch("compensation", "flow-trailer");
-    let log = dir.join("hold.csv");
-    let o = eha(&[
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
+    let log = hold_log(
+        &dir,
         "8",
-        "--effects",
-        "piston_ripple:amplitude_ratio=0.05",
-        "--out",
-        s(&log),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        &["--effects", "piston_ripple:amplitude_ratio=0.05"],
+    );
     let (table, json) = (dir.join("t.table"), dir.join("t.json"));
-    let o = eha(&[
-        "compensate",
-        s(&log),
-        "--out",
-        s(&table),
-        "--json",
-        s(&json),
-    ]);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = compensate(&log, &table, &["--json", s(&json)]);
     let len = fs::metadata(&table).unwrap().len() as usize;
     assert_eq!(len, firmware::compensation::record::RECORD_LEN + 12 + 8 * 4);
     let j: serde_json::Value = serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
@@ -380,19 +367,9 @@ fn eha_compensate_carries_the_speed_modulation_in_the_table_file() {
         .map(|p| &p[..2])
         .collect();
     assert_eq!(sets, ["40", "41", "42", "43", "3C"], "{out}");
-    let sim = dir.join("sim.csv");
-    let o = eha(&[
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
-        "1",
-        "--compensation",
-        s(&table),
-        "--out",
-        s(&sim),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sim = dir.join("sim");
+    std::fs::create_dir_all(&sim).unwrap();
+    let sim = hold_log(&sim, "1", &["--compensation", s(&table)]);
     let head = fs::read_to_string(&sim).unwrap();
     assert!(
         head.contains("speed modulation 9 pistons"),
