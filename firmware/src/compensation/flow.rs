@@ -46,6 +46,7 @@
 //! milliamperes).
 
 use crate::commissioning::gains::torque_constant;
+use crate::pi::saturate;
 use core::f32::consts::PI;
 
 /// Fewest pistons the closed form holds for (z = 1 and 2 are not a cosine cap of half
@@ -187,7 +188,7 @@ impl FlowRipple {
         let f = 1.0 + d;
         let i = -self.inertia_a * speed_ref * speed_ref * slope / (f * f * f);
         let lim = self.max_current_a;
-        (speed_ref / (1.0 + d_ref), i.clamp(-lim, lim))
+        (speed_ref / (1.0 + d_ref), saturate(i, -lim, lim))
     }
 }
 
