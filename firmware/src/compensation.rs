@@ -46,6 +46,7 @@
 //! ([`record::read`]): magic, version, bin and channel counts, per-channel LSBs, i16
 //! values, CRC-32. While a table loads, or after a refused one, the feed-forward is off.
 
+pub mod flow;
 pub mod record;
 
 use crate::angle_grid::position;
@@ -96,6 +97,17 @@ pub struct CompensationConfig {
     pub scale: f32,
     /// Largest amplitude the feed-forward may reach over the operating range. [A]
     pub max_current_a: f32,
+    /// Pistons z of the pump whose flow ripple the speed modulation cancels ([`flow`];
+    /// 0: no modulation, else at least [`flow::MIN_PISTONS`]). [1]
+    pub flow_pistons: u32,
+    /// The pump's flow ripple, peak-to-peak over the mean flow (0: no modulation). [1]
+    pub flow_ratio: f32,
+    /// Phase of the ripple's shape against the encoder's angle. [rad]
+    pub flow_phase_rad: f32,
+    /// Shaft inertia (motor and pump) of the modulation's acceleration current. [kg·m²]
+    pub inertia_kg_m2: f32,
+    /// Largest modulation depth `scale·flow_ratio` (peak-to-peak over the mean speed). [1]
+    pub max_flow_ratio: f32,
 }
 
 impl CompensationConfig {
@@ -106,6 +118,11 @@ impl CompensationConfig {
             enabled: false,
             scale: 1.0,
             max_current_a: 3.0,
+            flow_pistons: 0,
+            flow_ratio: 0.0,
+            flow_phase_rad: 0.0,
+            inertia_kg_m2: 8.0e-4,
+            max_flow_ratio: 0.1,
         }
     }
 
@@ -121,6 +138,43 @@ impl CompensationConfig {
             return Err(ConfigError {
                 field: "compensation.max_current_a",
                 problem: "must be within 0..=10",
+            });
+        }
+        if self.flow_pistons > 31 || (1..flow::MIN_PISTONS).contains(&self.flow_pistons) {
+            return Err(ConfigError {
+                field: "compensation.flow_pistons",
+                problem: "must be 0 (off) or within 3..=31",
+            });
+        }
+        let within = |v: f32, hi: f32| v.is_finite() && (0.0..=hi).contains(&v);
+        if !within(self.flow_ratio, 0.5) {
+            return Err(ConfigError {
+                field: "compensation.flow_ratio",
+                problem: "must be within 0..=0.5",
+            });
+        }
+        if !within(self.flow_phase_rad, core::f32::consts::TAU) {
+            return Err(ConfigError {
+                field: "compensation.flow_phase_rad",
+                problem: "must be within 0..=2*pi",
+            });
+        }
+        if !within(self.inertia_kg_m2, 1.0) {
+            return Err(ConfigError {
+                field: "compensation.inertia_kg_m2",
+                problem: "must be within 0..=1",
+            });
+        }
+        if !within(self.max_flow_ratio, 0.5) {
+            return Err(ConfigError {
+                field: "compensation.max_flow_ratio",
+                problem: "must be within 0..=0.5",
+            });
+        }
+        if self.scale * self.flow_ratio > self.max_flow_ratio {
+            return Err(ConfigError {
+                field: "compensation.flow_ratio",
+                problem: "scale * flow_ratio must be at most compensation.max_flow_ratio",
             });
         }
         Ok(())
@@ -297,6 +351,8 @@ pub struct Compensation {
     lead_bins: f32,
     p_max_pa: f32,
     i_max_a: f32,
+    /// The speed modulation against the pump's flow ripple.
+    flow: flow::FlowRipple,
 }
 
 impl Compensation {
@@ -311,6 +367,7 @@ impl Compensation {
             lead_bins: 0.0,
             p_max_pa: 0.0,
             i_max_a: 0.0,
+            flow: flow::FlowRipple::OFF,
         };
         c.retune(cfg);
         c
@@ -327,11 +384,20 @@ impl Compensation {
         self.lead_bins = self.lead_s * BINS_PER_RAD;
         self.p_max_pa = cfg.limits.over_pressure_pa;
         self.i_max_a = cfg.speed.iq_limit_a;
+        self.flow = flow::FlowRipple::new(cfg, cfg.compensation.enabled, self.lead_s);
     }
 
-    /// The q-current feed-forward at shaft angle `theta_m` [rad] (in [0, 2π), the
+    /// The speed modulation against the pump's flow ripple (off unless enabled with a
+    /// piston count and a ratio; acts whether or not a table is loaded).
+    pub fn flow(&self) -> &flow::FlowRipple {
+        &self.flow
+    }
+
+    /// The q-current feed-forward [A] at shaft angle `theta_m` [rad] (in [0, 2π), the
     /// encoder's), speed `omega` [rad/s], port-A pressure `p_pa` [Pa] and q-current
-    /// reference `iq_ref` [A]. [A]
+    /// reference `iq_ref` [A]; and the per-current channel g·c_i, the flux harmonics'
+    /// share of the magnet flux the current loop's decoupling takes for their back-EMF
+    /// ([`crate::current_loop`]). [1]
     ///
     /// The same cost whether it acts or not (a zero gain multiplies a finite table), so the
     /// step's worst case is its every case. The bin comes from the angle in bins, a
@@ -339,11 +405,12 @@ impl Compensation {
     /// conversion then floors, and the fraction is the float remainder (no fixed-point
     /// mask and scale as in [`crate::angle_grid`], three instructions fewer).
     #[inline(always)]
-    pub fn current(&self, theta_m: f32, omega: f32, p_pa: f32, iq_ref: f32) -> f32 {
+    pub fn current(&self, theta_m: f32, omega: f32, p_pa: f32, iq_ref: f32) -> (f32, f32) {
         let bins = BINS as f32 + theta_m * BINS_PER_RAD + omega * self.lead_bins;
         let whole = bins as i32;
         let [c0, cp, ci] = self.table.interpolate(whole as usize, bins - whole as f32);
-        self.gain * (c0 + cp * p_pa + ci * iq_ref)
+        let flux = self.gain * ci;
+        (self.gain * (c0 + cp * p_pa) + flux * iq_ref, flux)
     }
 
     /// The table in use (or being loaded).

@@ -570,10 +570,10 @@ impl Controller {
                             stepped,
                             ..
                         }) => stepped,
-                        _ => self.speed.step(self.speed_ref, w),
+                        _ => self.speed_step(w),
                     };
                 }
-                Mode::Pressure => self.iq_ref = self.speed.step(self.speed_ref, w),
+                Mode::Pressure => self.iq_ref = self.speed_step(w),
                 Mode::Calibrating => self.commission_speed_tick(w),
                 _ => {}
             }
@@ -583,10 +583,11 @@ impl Controller {
         let mut bridge = mode.is_active();
         let mut conditions = Conditions::default();
         self.iq_ff = 0.0;
+        let mut flux_ripple = 0.0;
         match mode {
             Mode::Speed | Mode::Pressure => {
                 self.id_ref = 0.0;
-                self.iq_ff = self.compensation.current(
+                (self.iq_ff, flux_ripple) = self.compensation.current(
                     self.theta_m,
                     self.speed.speed(),
                     self.p_pa,
@@ -626,7 +627,7 @@ impl Controller {
             };
             match self.open_loop_voltage.take() {
                 Some(u) => self.current.apply_voltage(m, theta_e, u),
-                None => self.current.step(m, theta_e, i_ref, omega_e),
+                None => self.current.step(m, theta_e, i_ref, omega_e, flux_ripple),
             }
         } else {
             CurrentLoopState {
@@ -727,6 +728,20 @@ impl Controller {
         }
     }
 
+    /// The speed loop's step on the measured speed `w` [rad/s] in Speed and Pressure: its
+    /// reference modulated against the pump's flow ripple and the modulation's
+    /// acceleration current added ([`crate::compensation::flow`]; off: the plain step),
+    /// within the q-current limit. [A]
+    #[inline]
+    fn speed_step(&mut self, w: f32) -> f32 {
+        let (w_ref, i_acc) = self
+            .compensation
+            .flow()
+            .modulate(self.theta_m, self.speed_ref);
+        let lim = self.cfg.speed.iq_limit_a;
+        saturate(self.speed.step(w_ref, w) + i_acc, -lim, lim)
+    }
+
     /// Resets the loops for a start from rest in `mode`.
     fn on_enter_active(&mut self, mode: Mode) {
         self.current.reset();
@@ -773,6 +788,8 @@ impl Controller {
                 if id.needs_disabled() && self.sup.mode() != Mode::Disabled {
                     return Err(CommandError::Parameter(ParamError::NotWhileRunning { id }));
                 }
+                self.check_flow_depth(id, value)
+                    .map_err(CommandError::Parameter)?;
                 let mut next = self.cfg;
                 id.set(&mut next, value).map_err(CommandError::Parameter)?;
                 self.check_compensation_parameter(id, &next)

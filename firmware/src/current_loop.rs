@@ -8,8 +8,13 @@
 //! and the modulator limits the resulting vector to the hexagon keeping its angle.
 //!
 //! Optional decoupling (eq. 2's speed voltages) adds `u_d,ff = −ω_e·L_q·i_q` and
-//! `u_q,ff = ω_e·(L_d·i_d + ψ_f)` before the limits, so the PIs see the bare R-L of the
-//! design; without it the back-EMF is a disturbance the integrators reject.
+//! `u_q,ff = ω_e·(L_d·i_d + ψ_f·(1 − k(θ)))` before the limits, so the PIs see the bare
+//! R-L of the design; without it the back-EMF is a disturbance the integrators reject.
+//! k(θ) is the torque feed-forward's per-current channel ([`crate::compensation`]): with
+//! i_d = 0 the flux harmonics' q-axis flux and its slope, ψ_df + ∂ψ_qf/∂θ_e, which set both
+//! the torque per ampere (eq. 19) and the q-axis back-EMF, equal ψ_f·(1 − k(θ)); so the
+//! same channel that cancels the harmonics' torque cancels their back-EMF, which the PI
+//! would otherwise pass at the 6th electrical harmonic's frequency as a current ripple.
 //!
 //! Budget: one sin/cos pair (an interpolated table, [`crate::transforms::sin_cos`]), about
 //! 60 floating-point operations; no division except one by the DC link, which is guarded,
@@ -171,7 +176,8 @@ impl CurrentLoop {
     }
 
     /// One current-loop step: measurement `m`, electrical angle `theta_e` [rad], current
-    /// references `i_ref` [A] and electrical speed `omega_e` [rad/s] for the decoupling.
+    /// references `i_ref` [A], electrical speed `omega_e` [rad/s] and the flux harmonics'
+    /// share `flux_ripple` = k(θ) of the magnet flux (0: none) for the decoupling.
     #[inline]
     pub fn step(
         &mut self,
@@ -179,13 +185,14 @@ impl CurrentLoop {
         theta_e: f32,
         i_ref: Dq,
         omega_e: f32,
+        flux_ripple: f32,
     ) -> CurrentLoopState {
         let (state, sc) = self.measure(m, theta_e);
         let i_dq = state.i_dq;
         let (ff_d, ff_q) = if self.decoupling {
             (
                 -omega_e * self.l_q * i_dq.q,
-                omega_e * (self.l_d * i_dq.d + self.psi_f),
+                omega_e * (self.l_d * i_dq.d + self.psi_f - self.psi_f * flux_ripple),
             )
         } else {
             (0.0, 0.0)
@@ -245,7 +252,7 @@ mod tests {
             -10.0 * libm::sinf(th - tau3),
             -10.0 * libm::sinf(th + tau3),
         ];
-        let s = cl.step(&adc_for(i), th, Dq { d: 0.0, q: 10.0 }, 0.0);
+        let s = cl.step(&adc_for(i), th, Dq { d: 0.0, q: 10.0 }, 0.0, 0.0);
         // Within the ADC's LSB (0.024 A).
         assert!((s.i_dq.q - 10.0).abs() < 0.06, "{:?}", s.i_dq);
         assert!(s.i_dq.d.abs() < 0.06, "{:?}", s.i_dq);
@@ -331,7 +338,7 @@ mod tests {
     fn first_output_is_the_proportional_action_plus_decoupling() {
         let cfg = Config::nominal();
         let mut cl = CurrentLoop::new(&cfg);
-        let s = cl.step(&adc_for([0.0; 3]), 0.0, Dq { d: 0.0, q: 2.0 }, 100.0);
+        let s = cl.step(&adc_for([0.0; 3]), 0.0, Dq { d: 0.0, q: 2.0 }, 100.0, 0.0);
         // Kp_q·2 A + ω_e·ψ_f = 26.4 + 18.27 V; d: −ω_e·L_q·0 = 0.
         assert!(
             (s.u_dq.q - (13.2 * 2.0 + 100.0 * 0.1827)).abs() < 1e-3,

@@ -48,6 +48,11 @@
 //!
 //! # Loading
 //!
+//! A record of the table before the flow-ripple modulation's parameters (ids 64–68:
+//! [`parameters::LEGACY_COUNT`] values, its own fingerprint, the feed-forward table at
+//! [`LEGACY_RECORD_LEN`]) still loads, the new parameters at their defaults (the
+//! modulation off); the next save writes the present layout.
+//!
 //! [`ParamStore::load`] takes the valid record with the larger sequence number. Without
 //! one, the outcome says why: both pages blank (never saved: defaults, no fault), or a
 //! record that is corrupt or of another format version or table (defaults and fault 16,
@@ -57,7 +62,7 @@
 
 use crate::compensation::record::{self as table_record, CHUNK_MAX};
 use crate::config::Config;
-use crate::parameters::{self, COUNT};
+use crate::parameters::{self, COUNT, LEGACY_COUNT};
 use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
 use embedded_storage::nor_flash::NorFlash;
 
@@ -75,8 +80,14 @@ pub const COMMIT_MAGIC: u32 = 0x544D_4D43;
 
 const HEADER_LEN: usize = 16;
 const CRC_AT: usize = HEADER_LEN + 4 * COUNT;
+/// Length of a record of `count` values with its padding. [bytes]
+const fn record_len(count: usize) -> usize {
+    (HEADER_LEN + 4 * count + 4).div_ceil(8) * 8
+}
 /// Length of the record with its padding, before the commit word. [bytes]
-pub const RECORD_LEN: usize = (CRC_AT + 4).div_ceil(8) * 8;
+pub const RECORD_LEN: usize = record_len(COUNT);
+/// Length of a record of the table before the flow-ripple parameters. [bytes]
+pub const LEGACY_RECORD_LEN: usize = record_len(LEGACY_COUNT);
 /// Where the feed-forward table's record starts. [bytes]
 pub const TABLE_AT: usize = RECORD_LEN;
 /// Length of the feed-forward table's record. [bytes]
@@ -93,8 +104,13 @@ pub const SPAN: usize = COMMIT_AT + COMMIT_LEN;
 enum Page {
     /// Erased header: never written (or the erase of a save was the last thing done).
     Blank,
-    /// A complete record of this format and table.
-    Valid { sequence: u32, values: [f32; COUNT] },
+    /// A complete record of this format and table (or of the legacy table, its new
+    /// parameters at their defaults), its feed-forward table at `table_at`.
+    Valid {
+        sequence: u32,
+        values: [f32; COUNT],
+        table_at: usize,
+    },
     /// A record of another format version or parameter table.
     OtherVersion,
     /// Anything else: bad magic, bad CRC, missing commit word.
@@ -134,8 +150,9 @@ pub struct ParamStore<F> {
     flash: F,
     pages: [u32; 2],
     slot_len: u32,
-    /// The slot the last [`ParamStore::load`] took its record from.
-    loaded: Option<u32>,
+    /// The slot the last [`ParamStore::load`] took its record from, and where its
+    /// feed-forward table starts in it.
+    loaded: Option<(u32, usize)>,
 }
 
 impl<F: NorFlash> ParamStore<F> {
@@ -179,13 +196,20 @@ impl<F: NorFlash> ParamStore<F> {
     }
 
     fn read_page(&mut self, page: u32) -> Page {
+        // A legacy record is shorter: the bytes read beyond it are its table's.
         let mut record = [0u8; RECORD_LEN];
+        if self.flash.read(page, &mut record).is_err() {
+            return Page::Corrupt;
+        }
+        let table_at = match usize::from(u16::from_le_bytes([record[6], record[7]])) {
+            LEGACY_COUNT => LEGACY_RECORD_LEN,
+            _ => RECORD_LEN,
+        };
         let mut commit = [0u8; COMMIT_LEN];
-        if self.flash.read(page, &mut record).is_err()
-            || self
-                .flash
-                .read(page + COMMIT_AT as u32, &mut commit)
-                .is_err()
+        if self
+            .flash
+            .read(page + (table_at + TABLE_LEN) as u32, &mut commit)
+            .is_err()
         {
             return Page::Corrupt;
         }
@@ -196,7 +220,13 @@ impl<F: NorFlash> ParamStore<F> {
     pub fn load(&mut self) -> (Option<[f32; COUNT]>, LoadOutcome) {
         let pages = self.pages.map(|p| self.read_page(p));
         let found = newest(&pages);
-        self.loaded = found.and_then(|(i, _, _)| self.pages.get(i).copied());
+        self.loaded = found.and_then(|(i, _, _)| {
+            let table_at = match pages.get(i) {
+                Some(Page::Valid { table_at, .. }) => *table_at,
+                _ => TABLE_AT,
+            };
+            self.pages.get(i).map(|p| (*p, table_at))
+        });
         match found {
             Some((_, sequence, values)) => (Some(values), LoadOutcome::Loaded { sequence }),
             // `matches!`, not `==`: a derived comparison of the value arrays costs flash.
@@ -211,10 +241,10 @@ impl<F: NorFlash> ParamStore<F> {
     /// Reads `buf.len()` bytes at offset `at` of the feed-forward table's record in the
     /// slot the last [`ParamStore::load`] took (false: none loaded, or the flash failed).
     pub fn read_table(&mut self, at: usize, buf: &mut [u8]) -> bool {
-        let Some(page) = self.loaded else {
+        let Some((page, table_at)) = self.loaded else {
             return false;
         };
-        at + buf.len() <= TABLE_LEN && self.flash.read(page + (TABLE_AT + at) as u32, buf).is_ok()
+        at + buf.len() <= TABLE_LEN && self.flash.read(page + (table_at + at) as u32, buf).is_ok()
     }
 
     /// Saves `values` (in [`parameters::ParamId::ALL`] order) and the feed-forward table
@@ -270,7 +300,10 @@ fn is_newer(a: u32, b: u32) -> bool {
 fn newest(pages: &[Page; 2]) -> Option<(usize, u32, [f32; COUNT])> {
     let mut best: Option<(usize, u32, [f32; COUNT])> = None;
     for (i, p) in pages.iter().enumerate() {
-        if let Page::Valid { sequence, values } = *p {
+        if let Page::Valid {
+            sequence, values, ..
+        } = *p
+        {
             if best.is_none_or(|(_, s, _)| is_newer(sequence, s)) {
                 best = Some((i, sequence, values));
             }
@@ -304,7 +337,9 @@ fn u32_at(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(w)
 }
 
-/// Classifies a slot from its parameter record and its commit word.
+/// Classifies a slot from its parameter record and its commit word. A record of the
+/// legacy table ([`LEGACY_COUNT`] values, [`parameters::LEGACY_FINGERPRINT`]) is valid
+/// too: its values are the first of [`ParamId::ALL`], the others take their defaults.
 fn parse(b: &[u8; RECORD_LEN], commit: &[u8; COMMIT_LEN]) -> Page {
     if b[..HEADER_LEN].iter().all(|x| *x == 0xFF) {
         return Page::Blank;
@@ -314,24 +349,41 @@ fn parse(b: &[u8; RECORD_LEN], commit: &[u8; COMMIT_LEN]) -> Page {
     }
     let version = u16::from_le_bytes([b[4], b[5]]);
     let count = u16::from_le_bytes([b[6], b[7]]);
-    if version != FORMAT_VERSION
-        || usize::from(count) != COUNT
-        || u32_at(b, 12) != parameters::LAYOUT_FINGERPRINT
-    {
+    let (n, fingerprint, table_at) = match usize::from(count) {
+        COUNT => (COUNT, parameters::LAYOUT_FINGERPRINT, RECORD_LEN),
+        LEGACY_COUNT => (
+            LEGACY_COUNT,
+            parameters::LEGACY_FINGERPRINT,
+            LEGACY_RECORD_LEN,
+        ),
+        _ => return Page::OtherVersion,
+    };
+    if version != FORMAT_VERSION || u32_at(b, 12) != fingerprint {
         return Page::OtherVersion;
     }
     let sequence = u32_at(b, 8);
-    if CRC.checksum(&b[..CRC_AT]) != u32_at(b, CRC_AT)
+    let crc_at = HEADER_LEN + 4 * n;
+    if CRC.checksum(&b[..crc_at]) != u32_at(b, crc_at)
         || u32_at(commit, 0) != COMMIT_MAGIC
         || u32_at(commit, 4) != sequence
     {
         return Page::Corrupt;
     }
     let mut values = [0f32; COUNT];
-    for (v, chunk) in values.iter_mut().zip(b[HEADER_LEN..CRC_AT].chunks_exact(4)) {
-        *v = f32::from_bits(u32_at(chunk, 0));
+    for (k, v) in values.iter_mut().enumerate() {
+        *v = match b.get(HEADER_LEN + 4 * k..).filter(|_| k < n) {
+            Some(chunk) => f32::from_bits(u32_at(chunk, 0)),
+            None => parameters::ADDED_DEFAULTS
+                .get(k.wrapping_sub(LEGACY_COUNT))
+                .copied()
+                .unwrap_or(0.0),
+        };
     }
-    Page::Valid { sequence, values }
+    Page::Valid {
+        sequence,
+        values,
+        table_at,
+    }
 }
 
 /// What boot made of the store.

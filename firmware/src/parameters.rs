@@ -16,7 +16,8 @@
 //! ([`crate::Controller`] applies it between control steps, bumplessly).
 //!
 //! Ids are grouped by tens (current loop 1–5, speed loop 10–15, pressure loop 20–25,
-//! hydraulics 30–36, telemetry 40, commissioning results 50–54, torque feed-forward 60–63);
+//! hydraulics 30–36, telemetry 40, commissioning results 50–54, torque feed-forward 60–63
+//! and its speed modulation against the pump's flow ripple 64–68);
 //! an id is never reused for another meaning. `compensation.clear` is an action: writing 1
 //! empties the feed-forward's table ([`crate::compensation`]), it always reads 0. The
 //! feed-forward's amplitude limit also involves its table, which the controller checks
@@ -65,6 +66,11 @@
 //! | 61 | `compensation.scale` | 1 | 0 | 2 | 1 |
 //! | 62 | `compensation.max_current_a` | A | 0 | 10 | 3 |
 //! | 63 | `compensation.clear` | 1 | 0 | 1 | 0 |
+//! | 64 | `compensation.flow_pistons` | 1 | 0 | 31 | 0 |
+//! | 65 | `compensation.flow_ratio` | 1 | 0 | 0.5 | 0 |
+//! | 66 | `compensation.flow_phase_rad` | rad | 0 | 6.2831855 | 0 |
+//! | 67 | `compensation.inertia_kg_m2` | kg·m² | 0 | 1 | 0.0008 |
+//! | 68 | `compensation.max_flow_ratio` | 1 | 0 | 0.5 | 0.1 |
 //!
 //! The table above is checked against the code by this module's tests.
 
@@ -72,7 +78,17 @@ use crate::config::{Config, ConfigError};
 use core::fmt;
 
 /// Number of parameters in the table.
-pub const COUNT: usize = 34;
+pub const COUNT: usize = 39;
+
+/// Number of parameters before the flow-ripple modulation's (ids 64–68) were added: a
+/// stored record of that table still loads ([`crate::param_store`]), the new ones at
+/// their defaults.
+pub const LEGACY_COUNT: usize = 34;
+
+/// The defaults of the parameters after the first [`LEGACY_COUNT`] (ids 64–68, those of
+/// [`Config::nominal`]: a test holds them to it), as constants, so loading a legacy record
+/// links no configuration.
+pub const ADDED_DEFAULTS: [f32; COUNT - LEGACY_COUNT] = [0.0, 0.0, 0.0, 8.0e-4, 0.1];
 
 /// A parameter of the live table; the discriminant is the wire id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -146,6 +162,19 @@ pub enum ParamId {
     CompensationMaxCurrent = 62,
     /// Action: 1 empties the feed-forward's table `compensation.clear`. [1]
     CompensationClear = 63,
+    /// Pistons of the pump whose flow ripple the speed modulation cancels (0: off)
+    /// `compensation.flow_pistons`. [1]
+    CompensationFlowPistons = 64,
+    /// The pump's flow ripple, peak-to-peak over mean flow `compensation.flow_ratio`. [1]
+    CompensationFlowRatio = 65,
+    /// Phase of the flow ripple against the encoder's angle `compensation.flow_phase_rad`.
+    /// [rad]
+    CompensationFlowPhase = 66,
+    /// Shaft inertia of the modulation's acceleration current `compensation.inertia_kg_m2`.
+    /// [kg·m²]
+    CompensationInertia = 67,
+    /// Largest speed-modulation depth `compensation.max_flow_ratio`. [1]
+    CompensationMaxFlowRatio = 68,
 }
 
 /// Name, unit and bounds of one parameter.
@@ -202,6 +231,11 @@ impl ParamId {
         ParamId::CompensationScale,
         ParamId::CompensationMaxCurrent,
         ParamId::CompensationClear,
+        ParamId::CompensationFlowPistons,
+        ParamId::CompensationFlowRatio,
+        ParamId::CompensationFlowPhase,
+        ParamId::CompensationInertia,
+        ParamId::CompensationMaxFlowRatio,
     ];
 
     const fn spec(self) -> Spec {
@@ -251,6 +285,16 @@ impl ParamId {
             CompensationScale => spec("compensation.scale", "1", 0.0, 2.0),
             CompensationMaxCurrent => spec("compensation.max_current_a", "A", 0.0, 10.0),
             CompensationClear => spec("compensation.clear", "1", 0.0, 1.0),
+            CompensationFlowPistons => spec("compensation.flow_pistons", "1", 0.0, 31.0),
+            CompensationFlowRatio => spec("compensation.flow_ratio", "1", 0.0, 0.5),
+            CompensationFlowPhase => spec(
+                "compensation.flow_phase_rad",
+                "rad",
+                0.0,
+                core::f32::consts::TAU,
+            ),
+            CompensationInertia => spec("compensation.inertia_kg_m2", "kg·m²", 0.0, 1.0),
+            CompensationMaxFlowRatio => spec("compensation.max_flow_ratio", "1", 0.0, 0.5),
         }
     }
 
@@ -302,6 +346,7 @@ impl ParamId {
             ParamId::TelemetryDecimation
                 | ParamId::CompensationEnabled
                 | ParamId::CompensationClear
+                | ParamId::CompensationFlowPistons
         )
     }
 
@@ -355,6 +400,12 @@ impl ParamId {
             CompensationScale => cfg.compensation.scale,
             CompensationMaxCurrent => cfg.compensation.max_current_a,
             CompensationClear => 0.0,
+            // At most 31, exact in f32.
+            CompensationFlowPistons => cfg.compensation.flow_pistons as f32,
+            CompensationFlowRatio => cfg.compensation.flow_ratio,
+            CompensationFlowPhase => cfg.compensation.flow_phase_rad,
+            CompensationInertia => cfg.compensation.inertia_kg_m2,
+            CompensationMaxFlowRatio => cfg.compensation.max_flow_ratio,
         }
     }
 
@@ -397,6 +448,11 @@ impl ParamId {
                 return;
             }
             CompensationClear => return,
+            CompensationFlowPistons => {
+                // Checked to be a whole number within 0..=31 before this is reached.
+                cfg.compensation.flow_pistons = value as u32;
+                return;
+            }
             StatorResistance => &mut cfg.motor.stator_resistance_ohm,
             DInductance => &mut cfg.motor.d_inductance_h,
             QInductance => &mut cfg.motor.q_inductance_h,
@@ -404,6 +460,10 @@ impl ParamId {
             EncoderOffset => &mut cfg.sensors.encoder_offset_rad,
             CompensationScale => &mut cfg.compensation.scale,
             CompensationMaxCurrent => &mut cfg.compensation.max_current_a,
+            CompensationFlowRatio => &mut cfg.compensation.flow_ratio,
+            CompensationFlowPhase => &mut cfg.compensation.flow_phase_rad,
+            CompensationInertia => &mut cfg.compensation.inertia_kg_m2,
+            CompensationMaxFlowRatio => &mut cfg.compensation.max_flow_ratio,
         };
         *slot = value;
     }
@@ -616,23 +676,43 @@ pub fn cross_check(cfg: &Config) -> Result<(), ConfigError> {
             "must be > 0 and at most speed.speed_limit_rad_s",
         );
     }
+    let c = &cfg.compensation;
+    if (1..crate::compensation::flow::MIN_PISTONS).contains(&c.flow_pistons) {
+        return err(
+            "compensation.flow_pistons",
+            "must be 0 (off) or within 3..=31",
+        );
+    }
+    if c.scale * c.flow_ratio > c.max_flow_ratio {
+        return err(
+            "compensation.flow_ratio",
+            "scale * flow_ratio must be at most compensation.max_flow_ratio",
+        );
+    }
     Ok(())
 }
 
 /// CRC-32 of the table's ids and names in order: changes whenever a parameter is added,
 /// removed, renumbered or renamed, so a stored record of another table is recognised.
 /// Computed at compile time (no names walked at run time).
-pub const LAYOUT_FINGERPRINT: u32 = {
+pub const LAYOUT_FINGERPRINT: u32 = fingerprint(COUNT);
+
+/// The fingerprint of the table before ids 64–68 ([`LEGACY_COUNT`] parameters, the first
+/// ones of [`ParamId::ALL`]).
+pub const LEGACY_FINGERPRINT: u32 = fingerprint(LEGACY_COUNT);
+
+/// CRC-32 of the first `n` parameters' ids and names.
+const fn fingerprint(n: usize) -> u32 {
     let mut digest = crate::param_store::CRC.digest();
     let mut i = 0;
-    while i < COUNT {
+    while i < n {
         let p = ParamId::ALL[i];
         digest.update(&[p as u8]);
         digest.update(p.spec().name.as_bytes());
         i += 1;
     }
     digest.finalize()
-};
+}
 
 #[cfg(test)]
 mod tests;

@@ -2,7 +2,8 @@
 //! runs: a table loaded over CAN and committed, refused naming the bound when its
 //! amplitude (or a scale, or a limit) breaks the limit, saved and found after a reboot,
 //! refused at boot with fault 21 when its stored record is wrong (the drive then runs
-//! uncompensated), and acting in Speed and Pressure only.
+//! uncompensated), and acting in Speed and Pressure only; the speed modulation against the
+//! pump's flow ripple likewise bounded and acting in Speed and Pressure only.
 
 mod common;
 
@@ -164,6 +165,94 @@ fn the_feed_forward_acts_in_speed_and_pressure_only() {
     set(&mut c, ParamId::CompensationClear, 1.0);
     assert!(c.compensation().table().is_zero());
     assert_eq!(c.parameter(ParamId::CompensationClear), 0.0);
+}
+
+/// The rejection of `r`: its reason and SI bound.
+fn rejected(r: Response) -> (RejectReason, f32) {
+    match r {
+        Response::Reply(Reply::Reject(r)) => (r.reason, r.si_bound().expect("an SI bound")),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn the_flow_modulation_depth_is_refused_above_its_bound_naming_it() {
+    let mut c = Controller::new(&Config::nominal());
+    let accepted = |r: Response| matches!(r, Response::Reply(Reply::Parameter { .. }));
+    assert!(accepted(set(&mut c, ParamId::CompensationFlowPistons, 9.0)));
+    assert!(accepted(set(&mut c, ParamId::CompensationFlowRatio, 0.06)));
+    // 1 and 2 pistons are no cosine cap: refused.
+    assert!(!accepted(set(
+        &mut c,
+        ParamId::CompensationFlowPistons,
+        2.0
+    )));
+    // A ratio of 0.2 over the default depth limit 0.1: refused, the bound is 0.1.
+    let (why, max) = rejected(set(&mut c, ParamId::CompensationFlowRatio, 0.2));
+    assert_eq!(why, RejectReason::AboveMaximum);
+    assert!((max - 0.1).abs() < 1e-6, "{max}");
+    // Scale 2 would make the depth 0.12: the largest scale is 0.1/0.06.
+    let (why, max) = rejected(set(&mut c, ParamId::CompensationScale, 2.0));
+    assert_eq!(why, RejectReason::AboveMaximum);
+    assert!((max - 0.1 / 0.06).abs() < 1e-4, "{max}");
+    // The limit under the depth: the smallest limit is the depth, 0.06.
+    let (why, min) = rejected(set(&mut c, ParamId::CompensationMaxFlowRatio, 0.05));
+    assert_eq!(why, RejectReason::BelowMinimum);
+    assert!((min - 0.06).abs() < 1e-6, "{min}");
+    assert_eq!(c.parameter(ParamId::CompensationFlowRatio), 0.06);
+    assert!(!c.compensation().flow().is_active(), "off until enabled");
+    assert!(accepted(set(&mut c, ParamId::CompensationEnabled, 1.0)));
+    assert!(c.compensation().flow().is_active(), "on without a table");
+}
+
+#[test]
+fn the_flow_modulation_acts_in_speed_and_pressure_only() {
+    // Two drives fed the same samples, one modulating a 9-piston pump's ripple (at 20 %
+    // peak-to-peak, so the difference shows), the other not: the q reference differs in
+    // Speed only (Pressure takes the same path), never in Disabled or Calibrating.
+    let mut cfg = Config::nominal();
+    cfg.compensation.max_flow_ratio = 0.5;
+    let mut on = Controller::new(&cfg);
+    let mut off = Controller::new(&cfg);
+    for (id, v) in [
+        (ParamId::CompensationFlowPistons, 9.0),
+        (ParamId::CompensationFlowRatio, 0.2),
+        (ParamId::CompensationEnabled, 1.0),
+    ] {
+        on.command(Command::SetParameter { id, value: v })
+            .expect("accepted");
+    }
+    let m = Measurements {
+        adc_dc_link: 2800,
+        adc_pressure: 6554 + 6291,
+        encoder_count: 10_000 / 100,
+        ..Measurements::default()
+    };
+    power_up(&mut on);
+    power_up(&mut off);
+    for mode in [Mode::Disabled, Mode::Calibrating, Mode::Speed] {
+        for c in [&mut on, &mut off] {
+            c.command(Command::SetSpeed { rad_s: 5.7 }).expect("speed");
+            c.command(Command::SetMode(mode)).expect("mode");
+        }
+        for _ in 0..40 {
+            on.on_current_sample(&m);
+            off.on_current_sample(&m);
+            let (a, b) = (on.telemetry().iq_ref_a, off.telemetry().iq_ref_a);
+            match mode {
+                Mode::Speed => {}
+                _ => assert_eq!(a, b, "{mode:?}"),
+            }
+        }
+        let (a, b) = (on.telemetry().iq_ref_a, off.telemetry().iq_ref_a);
+        if mode == Mode::Speed {
+            assert!((a - b).abs() > 1e-3, "{a} vs {b}");
+        }
+        for c in [&mut on, &mut off] {
+            c.command(Command::SetMode(Mode::Disabled))
+                .expect("disabled");
+        }
+    }
 }
 
 const SLOT: u32 = 4096;

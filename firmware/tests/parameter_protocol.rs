@@ -51,6 +51,8 @@ fn other_valid_value(p: ParamId) -> f32 {
         d + 1.0,
         0.5 * (p.min() + p.max()),
         p.max(),
+        // `compensation.flow_ratio`: a depth within the default `max_flow_ratio`.
+        p.min() + 0.1 * (p.max() - p.min()),
     ];
     candidates
         .into_iter()

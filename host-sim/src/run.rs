@@ -11,8 +11,8 @@
 
 use crate::bench_log::limits::{physical_range, MAX_ROWS};
 use crate::bench_log::BenchLog;
+use crate::compensate::Feedforward;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
-use firmware::compensation::Table;
 use firmware::config::Config;
 use firmware::parameters::ParamId;
 use firmware::Command;
@@ -49,9 +49,10 @@ pub struct RunOptions {
     pub progress: bool,
     /// Metadata lines for the log.
     pub metadata: Vec<(String, String)>,
-    /// A torque feed-forward table loaded into the controller before the run, and enabled,
-    /// as the drive loads it from flash (`None`: uncompensated).
-    pub compensation: Option<Table>,
+    /// A torque feed-forward table (and the speed modulation's parameters) loaded into the
+    /// controller before the run, and enabled, as the drive loads it from flash (`None`:
+    /// uncompensated).
+    pub compensation: Option<Feedforward>,
 }
 
 /// How a run of `duration_s` [s] is logged at `log_rate_hz` [Hz] with the PWM period
@@ -79,12 +80,17 @@ pub fn first_unphysical(log: &BenchLog) -> Option<(f64, &'static str, f64)> {
     first.map(|(i, name, v)| (log.t_s.get(i).copied().unwrap_or(f64::NAN), name, v))
 }
 
-/// Installs `table` in the loop's controller and enables the feed-forward, as the drive
-/// does at boot from its stored table (the amplitude limit checked the same way).
-pub fn load_compensation(cl: &mut ClosedLoop, table: &Table) -> Result<(), String> {
+/// Installs `ff`'s table in the loop's controller, sets the speed modulation's parameters
+/// and enables the feed-forward, as the drive does at boot from its stored table and
+/// parameters (the amplitude and depth limits checked the same way).
+pub fn load_compensation(cl: &mut ClosedLoop, ff: &Feedforward) -> Result<(), String> {
     let c = cl.controller_mut();
-    c.install_compensation(table)
+    c.install_compensation(&ff.table)
         .map_err(|e| format!("the drive refuses the table: {e}"))?;
+    for (id, value) in ff.flow.iter().flat_map(|f| f.parameters()) {
+        c.command(Command::SetParameter { id, value })
+            .map_err(|e| format!("the drive refuses the speed modulation: {e}"))?;
+    }
     c.command(Command::SetParameter {
         id: ParamId::CompensationEnabled,
         value: 1.0,

@@ -100,7 +100,8 @@ fn run() -> Result<(), ()> {
         // The current-loop step as the controller runs it in Speed and Pressure: the
         // torque feed-forward looked up and added to the q reference, then the step.
         t_current.measure((&mut current, &compensation), |(c, ff)| {
-            let iq_ff = ff.current(tel.theta_m_rad, tel.speed_rad_s, tel.p_pa, tel.iq_ref_a);
+            let (iq_ff, flux) =
+                ff.current(tel.theta_m_rad, tel.speed_rad_s, tel.p_pa, tel.iq_ref_a);
             c.step(
                 &m,
                 tel.theta_m_rad * pole_pairs,
@@ -109,6 +110,7 @@ fn run() -> Result<(), ()> {
                     q: tel.iq_ref_a + iq_ff,
                 },
                 tel.speed_rad_s * pole_pairs,
+                flux,
             )
         });
         let sc = t_sin_cos.measure(tel.theta_m_rad * pole_pairs, sin_cos);
@@ -125,8 +127,11 @@ fn run() -> Result<(), ()> {
             ),
             |(v, u_dc)| modulate(v, u_dc),
         );
-        t_speed.measure(&mut speed, |sl| {
-            sl.step(tel.speed_ref_rad_s, tel.speed_rad_s)
+        // The speed-loop step as the controller runs it: the reference modulated against
+        // the pump's flow ripple, the acceleration current added.
+        t_speed.measure((&mut speed, &compensation), |(sl, ff)| {
+            let (w_ref, i_acc) = ff.flow().modulate(tel.theta_m_rad, tel.speed_ref_rad_s);
+            sl.step(w_ref, tel.speed_rad_s) + i_acc
         });
         t_pressure.measure(&mut pressure, |pl| pl.step(tel.p_pa));
     }
@@ -150,10 +155,14 @@ fn run() -> Result<(), ()> {
 
 /// An active feed-forward for the measurement: every channel non-zero (a 72/rev line in
 /// the constant channel, 18/rev per pressure, 24/rev per current, a few percent of the
-/// nominal rig's torques), so the step takes its full path.
+/// nominal rig's torques), so the step takes its full path; and the speed modulation
+/// against a 9-piston pump's flow ripple, so the speed-loop step does too.
 fn feed_forward(config: &firmware::Config) -> Option<Compensation> {
     let mut cfg = *config;
     cfg.compensation.enabled = true;
+    // The speed modulation of a 9-piston pump's kinematic ripple.
+    cfg.compensation.flow_pistons = 9;
+    cfg.compensation.flow_ratio = 0.0152;
     let mut raw = [[0i16; CHANNELS]; BINS];
     for (b, r) in raw.iter_mut().enumerate() {
         let th = b as f32 * core::f32::consts::TAU / BINS as f32;
@@ -164,7 +173,7 @@ fn feed_forward(config: &firmware::Config) -> Option<Compensation> {
     let table = Table::from_raw([19, 44, 20], &raw)?;
     let mut c = Compensation::new(&cfg);
     c.install(&table, &cfg).ok()?;
-    c.is_active().then_some(c)
+    (c.is_active() && c.flow().is_active()).then_some(c)
 }
 
 #[defmt::panic_handler]

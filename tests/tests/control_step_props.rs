@@ -183,7 +183,7 @@ proptest! {
     ) {
         let mut l = CurrentLoop::new(&Config::nominal());
         for _ in 0..3 {
-            let s = l.step(&m, theta, Dq { d, q }, omega);
+            let s = l.step(&m, theta, Dq { d, q }, omega, 0.0);
             prop_assert!(duties_ok(&s.duties), "{:?}", s.duties);
         }
     }

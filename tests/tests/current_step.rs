@@ -79,6 +79,7 @@ fn q_step(pwm_hz: f64, seed: u64) -> Response {
             encoder.electrical_angle(m.encoder_count),
             Dq { d: 0.0, q: iq_ref },
             0.0,
+            0.0,
         );
         let d = out.duties;
         plant.advance(

@@ -67,7 +67,9 @@ fn the_feed_forward_scales_each_channel_with_its_regressor() {
     let th = 100.0 * TAU / BINS as f32;
     let (p, iq) = (5e6, 1.2);
     let want = 0.5 * (3000.0 * lsb(14) + 500.0 * lsb(36) * p - 700.0 * lsb(16) * iq);
-    let got = c.current(th, 0.0, p, iq);
+    let (got, flux) = c.current(th, 0.0, p, iq);
+    // The per-current channel times the gain: the flux harmonics' share.
+    assert!((flux - 0.5 * -700.0 * lsb(16)).abs() < 1e-9, "{flux}");
     assert!(
         (got - want).abs() < 1e-6 * want.abs().max(1.0),
         "{got} vs {want}"
@@ -76,13 +78,13 @@ fn the_feed_forward_scales_each_channel_with_its_regressor() {
     let lead = c.lead_s();
     assert!((lead - (0.012 / 13.2 + 1.0 / 20e3)).abs() < 1e-7, "{lead}");
     let w = 50.0;
-    let ahead = c.current(th - w * lead, w, p, iq);
+    let (ahead, _) = c.current(th - w * lead, w, p, iq);
     assert!((ahead - got).abs() < 2e-3 * got.abs(), "{ahead} vs {got}");
     // Off: zero whatever the table holds.
     let mut off = cfg;
     off.compensation.enabled = false;
     c.retune(&off);
-    assert_eq!(c.current(th, 0.0, p, iq), 0.0);
+    assert_eq!(c.current(th, 0.0, p, iq), (0.0, 0.0));
     assert!(!c.is_active());
 }
 
@@ -121,7 +123,7 @@ fn the_amplitude_bound_is_the_sum_of_the_channel_peaks_over_the_operating_range(
     let mut c = Compensation::new(&low);
     assert!(c.install(&t, &low).is_err());
     assert!(c.table().is_zero());
-    assert_eq!(c.current(0.1, 0.0, 5e6, 1.0), 0.0);
+    assert_eq!(c.current(0.1, 0.0, 5e6, 1.0), (0.0, 0.0));
 }
 
 fn record_of(t: &Table) -> Vec<u8> {

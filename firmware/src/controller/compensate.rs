@@ -73,6 +73,37 @@ impl Controller {
         .map_err(CommandError::Compensation)
     }
 
+    /// Setting parameter `id` to `value` keeps the speed modulation's depth
+    /// `scale·flow_ratio` within `compensation.max_flow_ratio`; otherwise the refusal
+    /// names the bound: the largest ratio or scale, or the smallest limit, the others
+    /// allow. (A value outside its own bounds is left to [`ParamId::set`].)
+    pub(super) fn check_flow_depth(&self, id: ParamId, value: f32) -> Result<(), ParamError> {
+        let c = &self.cfg.compensation;
+        let (scale, ratio, max) = match id {
+            ParamId::CompensationScale => (value, c.flow_ratio, c.max_flow_ratio),
+            ParamId::CompensationFlowRatio => (c.scale, value, c.max_flow_ratio),
+            ParamId::CompensationMaxFlowRatio => (c.scale, c.flow_ratio, value),
+            _ => return Ok(()),
+        };
+        if id.check(value).is_err() || scale * ratio <= max {
+            return Ok(());
+        }
+        Err(match id {
+            ParamId::CompensationMaxFlowRatio => ParamError::BelowMinimum {
+                id,
+                min: scale * ratio,
+            },
+            ParamId::CompensationScale => ParamError::AboveMaximum {
+                id,
+                max: max / ratio,
+            },
+            _ => ParamError::AboveMaximum {
+                id,
+                max: max / scale,
+            },
+        })
+    }
+
     /// A change of parameter `id` giving the configuration `next` keeps the feed-forward's
     /// amplitude within its limit; otherwise the refusal names the bound: the largest
     /// scale, or the smallest limit, the present table allows.

@@ -391,6 +391,47 @@ fn a_record_written_to_the_documented_layout_loads() {
 }
 
 #[test]
+fn a_record_of_the_table_before_the_flow_ripple_parameters_still_loads() {
+    // 34 values, the fingerprint of the first 34 ids and names (computed here with the
+    // table-driven CRC), the feed-forward table right after the shorter record: the
+    // values load, ids 64-68 at their defaults, and the table is found.
+    let t = table(3.0);
+    let legacy = &t[..34];
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
+    let mut d = crc.digest();
+    for p in &ParamId::ALL[..34] {
+        d.update(&[*p as u8]);
+        d.update(p.name().as_bytes());
+    }
+    let rec = documented_record(2, d.finalize(), 9, legacy);
+    assert_eq!(
+        rec.len(),
+        SPAN - 16,
+        "four values fewer, 16 bytes with padding"
+    );
+    let mut s = store(flash_with(&rec));
+    let (values, outcome) = s.load();
+    assert_eq!(outcome, LoadOutcome::Loaded { sequence: 9 });
+    let values = values.unwrap();
+    assert_eq!(&values[..34], legacy);
+    for (p, v) in ParamId::ALL[34..].iter().zip(&values[34..]) {
+        assert_eq!(*v, p.default_value(), "{p}");
+    }
+    assert_eq!(values[34..], [0.0, 0.0, 0.0, 8.0e-4, 0.1]);
+    assert_eq!(loaded_table(&mut s), Ok(Table::ZERO));
+    // A save writes the present layout; the next load takes it.
+    save(&mut s, &values).unwrap();
+    assert_eq!(
+        s.load(),
+        (Some(values), LoadOutcome::Loaded { sequence: 10 })
+    );
+    // The legacy record with a flipped value is still refused.
+    let mut bad = rec.clone();
+    bad[20] ^= 1;
+    boots_to_defaults_with_fault(flash_with(&bad), LoadOutcome::Corrupt);
+}
+
+#[test]
 fn the_save_after_the_last_sequence_number_wins() {
     // Found by fuzzing: a record at sequence u32::MAX; the save after it wraps to 0 and
     // used to lose to it ("newer = larger"), so the saved table vanished at the next boot.

@@ -265,3 +265,10 @@ fn bounds_and_cross_check_accept_exactly_what_the_validator_accepts() {
         "{accepted} / {refused}"
     );
 }
+
+#[test]
+fn the_added_parameters_constant_defaults_are_the_nominal_ones() {
+    for (p, d) in ParamId::ALL[LEGACY_COUNT..].iter().zip(ADDED_DEFAULTS) {
+        assert_eq!(p.default_value(), d, "{p}");
+    }
+}

@@ -1,15 +1,18 @@
 //! The CAN frames that load a table into a drive, built with the firmware's own encoder
 //! (`firmware::can_protocol`): the header, the bins in order, the commit with the record's
-//! CRC, then `compensation.enabled = 1`; `SaveParameters` (in Disabled) keeps it over a
+//! CRC, the speed modulation's parameters if there are any ([`super::flow`]), then
+//! `compensation.enabled = 1`; `SaveParameters` (in Disabled) keeps it over a
 //! power cycle. Printed in `cansend` notation.
 
+use super::Feedforward;
 use firmware::can_protocol::{encode_command, encode_set_parameter, Frame, NodeId, Request};
-use firmware::compensation::{record, Table, BINS};
+use firmware::compensation::{record, BINS};
 use firmware::parameters::ParamId;
 
-/// The frames loading `table` into drive `node`, enabling it and saving it.
-pub fn frames(table: &Table, node: NodeId) -> Vec<Frame> {
-    let mut out = Vec::with_capacity(BINS + 4);
+/// The frames loading `ff` into drive `node`, enabling it and saving it.
+pub fn frames(ff: &Feedforward, node: NodeId) -> Vec<Frame> {
+    let table = &ff.table;
+    let mut out = Vec::with_capacity(BINS + 8);
     out.push(encode_command(
         &Request::CompensationHeader {
             exponents: table.exponents(),
@@ -32,6 +35,9 @@ pub fn frames(table: &Table, node: NodeId) -> Vec<Frame> {
         },
         node,
     ));
+    for (id, v) in ff.flow.iter().flat_map(|f| f.parameters()) {
+        out.push(encode_set_parameter(id, v, node));
+    }
     out.push(encode_set_parameter(
         ParamId::CompensationEnabled,
         1.0,
@@ -55,6 +61,7 @@ mod tests {
     use super::*;
     use firmware::can_protocol::decode_command;
     use firmware::can_server::serve;
+    use firmware::compensation::Table;
     use firmware::{Config, Controller};
 
     #[test]
@@ -64,8 +71,18 @@ mod tests {
         raw[10] = [1000, -20, 300];
         let t = Table::from_raw([16, 40, 18], &raw).unwrap();
         let node = NodeId::new(1).unwrap();
-        let frames = frames(&t, node);
-        assert_eq!(frames.len(), BINS + 4);
+        let flow = super::super::flow::FlowParams {
+            pistons: 9,
+            ratio: 0.0152,
+            phase_rad: 0.0,
+            inertia_kg_m2: 8e-4,
+        };
+        let ff = Feedforward {
+            table: t.clone(),
+            flow: Some(flow),
+        };
+        let frames = frames(&ff, node);
+        assert_eq!(frames.len(), BINS + 8);
         assert_eq!(frames[0].to_string(), "251#FFFF102812000002");
         let mut c = Controller::new(&Config::nominal());
         // The last frame (SaveParameters) is served by the application (flash).
@@ -77,5 +94,8 @@ mod tests {
         assert_eq!(c.compensation().table(), &t);
         assert_eq!(c.parameter(ParamId::CompensationEnabled), 1.0);
         assert!(c.compensation().is_active());
+        assert_eq!(c.parameter(ParamId::CompensationFlowPistons), 9.0);
+        assert_eq!(c.parameter(ParamId::CompensationFlowRatio), 0.0152);
+        assert!(c.compensation().flow().is_active());
     }
 }

@@ -6,6 +6,7 @@
 //!
 //! - [`learn`]: the diagnosis's significant angle-locked effects, combined over logs.
 //! - [`model`]: the channels from a rig's equations, the rig extended by those effects.
+//! - [`flow`]: the speed modulation against the pump's flow ripple, its parameters.
 //! - [`histogram`]: the anchors' method, the q current binned by angle, for comparison.
 //! - [`table`]: channels as harmonics → the drive's table (pre-emphasis, quantisation).
 //! - [`predict`]: holding runs without and with a table, their pulsation.
@@ -17,6 +18,7 @@
 //! pressure the load-scaled ones.
 
 pub mod can;
+pub mod flow;
 pub mod histogram;
 pub mod learn;
 pub mod model;
@@ -30,6 +32,7 @@ use crate::output::{print_stdout, write_json, CliError};
 use clap::{Args, ValueEnum};
 use firmware::compensation::record::{self, RECORD_LEN};
 use firmware::compensation::{Channel, Compensation, Table, BINS, CHANNELS};
+use flow::FlowParams;
 use learn::Learned;
 use plant_model::Rig;
 use predict::reduction_percent;
@@ -73,7 +76,9 @@ pub struct CompensateArgs {
     pub json: Option<PathBuf>,
     /// Effects to leave out of the model-based table (catalogue names, comma-separated),
     /// e.g. `piston_ripple` to keep the pump's torque ripple, which slows the shaft where
-    /// the pump delivers more and so evens out its flow.
+    /// the pump delivers more and so evens out its flow (and no speed modulation), or
+    /// `flow_ripple` for the torque table without the speed modulation against the pump's
+    /// flow ripple.
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub exclude: Vec<String>,
     /// Also write the loading frames as a `candump -l` log (`canplayer -I FILE` replays it).
@@ -135,28 +140,105 @@ fn read_logs(rig: &Rig, args: &CompensateArgs) -> Result<Vec<BenchLog>, CliError
         .collect()
 }
 
+/// What `eha compensate` loads into a drive: the torque table and, when the pump's ripple
+/// was learned, the speed modulation's parameters ([`flow`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Feedforward {
+    /// The angle-indexed q-current table.
+    pub table: Table,
+    /// The speed modulation against the pump's flow ripple (`None`: off).
+    pub flow: Option<FlowParams>,
+}
+
+impl Feedforward {
+    /// The table alone (no speed modulation).
+    pub fn table_only(table: Table) -> Feedforward {
+        Feedforward { table, flow: None }
+    }
+
+    /// The table file: the drive's table record, then the modulation's parameter trailer
+    /// if there is one.
+    pub fn file_bytes(&self) -> Vec<u8> {
+        let mut bytes = vec![0u8; RECORD_LEN];
+        if let Ok(b) = <&mut [u8; RECORD_LEN]>::try_from(bytes.as_mut_slice()) {
+            record::Encoder::write_all(&self.table, b);
+        }
+        if let Some(f) = &self.flow {
+            bytes.extend_from_slice(&f.trailer());
+        }
+        bytes
+    }
+
+    /// Checks it against `rig`'s controller configuration as the drive would: the table's
+    /// amplitude, the modulation's parameters and depth. The error names the bound.
+    pub fn check(&self, rig: &Rig) -> Result<(), String> {
+        let mut cfg = closed_loop::controller_config(rig);
+        cfg.compensation.enabled = true;
+        Compensation::check_amplitude(&self.table, &cfg).map_err(|e| e.to_string())?;
+        match &self.flow {
+            Some(f) => f.apply(&mut cfg),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Longest table file: the record and a trailer of the modulation's parameters. [bytes]
+const MAX_FILE_LEN: u64 = RECORD_LEN as u64 + 12 + 8 * flow::FLOW_IDS.len() as u64;
+
 /// Reads a table file written by `eha compensate` and checks it as the drive checks its
 /// stored table (size, magic, version, bins, channels, exponents, CRC), then its amplitude
-/// against the limit of `rig`'s controller configuration. Bad input names the file.
-pub fn read_table(path: &std::path::Path, rig: &Rig) -> Result<Table, CliError> {
+/// against the limit of `rig`'s controller configuration, and the modulation's parameter
+/// trailer if there is one ([`flow`]). Bad input names the file.
+pub fn read_table(path: &std::path::Path, rig: &Rig) -> Result<Feedforward, CliError> {
     let bad =
         |why: String| CliError::BadInput(format!("compensation table `{}`: {why}", path.display()));
     let len = std::fs::metadata(path)
         .map_err(|e| bad(crate::output::paths::describe(&e)))?
         .len();
-    if len != RECORD_LEN as u64 {
+    if !(RECORD_LEN as u64..=MAX_FILE_LEN).contains(&len) {
         return Err(bad(record::RecordError::Length {
             found: usize::try_from(len).unwrap_or(usize::MAX),
         }
         .to_string()));
     }
     let bytes = std::fs::read(path).map_err(|e| bad(crate::output::paths::describe(&e)))?;
+    let (rec, trailer) = bytes.split_at(RECORD_LEN.min(bytes.len()));
     let mut table = Table::ZERO;
-    record::from_bytes(&bytes, &mut table).map_err(|e| bad(e.to_string()))?;
-    let mut cfg = closed_loop::controller_config(rig);
-    cfg.compensation.enabled = true;
-    Compensation::check_amplitude(&table, &cfg).map_err(|e| bad(e.to_string()))?;
-    Ok(table)
+    record::from_bytes(rec, &mut table).map_err(|e| bad(e.to_string()))?;
+    let flow = if trailer.is_empty() {
+        None
+    } else {
+        Some(FlowParams::from_trailer(trailer).map_err(bad)?)
+    };
+    let ff = Feedforward { table, flow };
+    ff.check(rig).map_err(bad)?;
+    Ok(ff)
+}
+
+/// The feed-forward learned from `found` (model) or `logs` (histogram) on `rig`: the table
+/// of [`table_of`] and, for the model, the speed modulation against the pump's flow ripple
+/// when `piston_ripple` was found and neither it nor [`flow::EXCLUDE_NAME`] is in
+/// `exclude`; refused when the drive would refuse it.
+pub fn feedforward_of(
+    found: &Found,
+    logs: &[BenchLog],
+    rig: &Rig,
+    method: Method,
+    exclude: &[String],
+) -> Result<Feedforward, CliError> {
+    let table = table_of(found, logs, rig, method, exclude)?;
+    let left_out = |n: &str| exclude.iter().any(|x| x == n);
+    let flow = match method {
+        Method::Model if !left_out("piston_ripple") && !left_out(flow::EXCLUDE_NAME) => found
+            .effects
+            .iter()
+            .find_map(|l| FlowParams::of_effect(&l.effect, rig)),
+        _ => None,
+    };
+    let ff = Feedforward { table, flow };
+    ff.check(rig)
+        .map_err(|e| CliError::BadInput(format!("the learned feed-forward is refused: {e}")))?;
+    Ok(ff)
 }
 
 /// The histogram's table from `logs`: their constant channels averaged.
@@ -249,11 +331,12 @@ pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> 
     if let Some(bad) = args
         .exclude
         .iter()
-        .find(|x| !learn::LINE_EFFECTS.contains(&x.as_str()))
+        .find(|x| !learn::LINE_EFFECTS.contains(&x.as_str()) && *x != flow::EXCLUDE_NAME)
     {
         return Err(CliError::BadInput(format!(
-            "--exclude `{bad}`: not an angle-locked effect (one of {})",
-            learn::LINE_EFFECTS.join(", ")
+            "--exclude `{bad}`: not an angle-locked effect (one of {}) or {}",
+            learn::LINE_EFFECTS.join(", "),
+            flow::EXCLUDE_NAME
         )));
     }
     let logs = read_logs(rig, args)?;
@@ -263,26 +346,26 @@ pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> 
     ));
     let learned = (|| {
         let found = find(&logs, rig)?;
-        let table = table_of(&found, &logs, rig, args.method, &args.exclude)?;
+        let ff = feedforward_of(&found, &logs, rig, args.method, &args.exclude)?;
         let plant = fitted_plant(&found, rig)?;
-        let (without, with) = predict::without_and_with(&plant, rig, &[&table])?;
+        let (without, with) = predict::without_and_with(&plant, rig, &[&ff])?;
         let with = with
             .into_iter()
             .next()
             .ok_or_else(|| CliError::Failed("no run with the table".into()))?;
-        Ok::<_, CliError>((found, table, without, with))
+        Ok::<_, CliError>((found, ff, without, with))
     })();
     busy.finish_and_clear();
-    let (found, table, without, with) = learned?;
-    let mut bytes = [0u8; RECORD_LEN];
-    record::Encoder::write_all(&table, &mut bytes);
+    let (found, ff, without, with) = learned?;
+    let table = &ff.table;
+    let bytes = ff.file_bytes();
     crate::output::atomic::write(&args.out, &bytes).map_err(|source| CliError::Write {
         file: args.out.clone(),
         source,
     })?;
     let node = firmware::can_protocol::NodeId::new(crate::tune::can::NODE)
         .map_err(|e| CliError::Failed(format!("CAN node: {e:?}")))?;
-    let frames = can::frames(&table, node);
+    let frames = can::frames(&ff, node);
     let peak = table.peak();
     let mut text = String::new();
     let _ = writeln!(
@@ -303,13 +386,29 @@ pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> 
     }
     let _ = writeln!(
         text,
-        "table: {BINS} bins; peaks {:.4} A, {:.3e} A/Pa, {:.4} A/A; written to {} ({RECORD_LEN} bytes, CRC {:#010x})",
+        "table: {BINS} bins; peaks {:.4} A, {:.3e} A/Pa, {:.4} A/A; written to {} ({} bytes, record CRC {:#010x})",
         peak[Channel::Constant as usize],
         peak[Channel::PerPressure as usize],
         peak[Channel::PerCurrent as usize],
         args.out.display(),
-        record::crc_of(&table)
+        bytes.len(),
+        record::crc_of(table)
     );
+    match &ff.flow {
+        Some(f) => {
+            let _ = writeln!(
+                text,
+                "speed modulation against the pump's flow ripple: {} pistons, {:.3} % peak-to-peak, phase {:.3} rad, J = {:.3e} kg·m²",
+                f.pistons,
+                100.0 * f.ratio,
+                f.phase_rad,
+                f.inertia_kg_m2
+            );
+        }
+        None => {
+            let _ = writeln!(text, "speed modulation against the pump's flow ripple: off");
+        }
+    }
     let _ = writeln!(
         text,
         "predicted, holding at 5 MPa on the rig with the learned effects (true signals, steady part):"
@@ -381,7 +480,13 @@ pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> 
                     "pressure_angle_locked_pp_pa": {"without": without.pressure_locked_pp_pa, "with": with.pressure_locked_pp_pa},
                     "speed_angle_locked_pp_rad_s": {"without": without.speed_locked_pp_rad_s, "with": with.speed_locked_pp_rad_s},
                 },
-                "table_crc": record::crc_of(&table),
+                "table_crc": record::crc_of(table),
+                "flow_ripple": ff.flow.map(|f| json!({
+                    "pistons": f.pistons,
+                    "ratio": f.ratio,
+                    "phase_rad": f.phase_rad,
+                    "inertia_kg_m2": f.inertia_kg_m2,
+                })),
                 "table_peaks": {"constant_a": peak[0], "per_pressure_a_per_pa": peak[1], "per_current": peak[2]},
                 "logs": args.logs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
             }),

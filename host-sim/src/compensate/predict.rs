@@ -12,11 +12,11 @@
 //! answering the transducer's noise (with the absorber fitted, most of what is left), and
 //! for the pressure the pump's kinematic flow ripple, which no torque cancels.
 
+use super::Feedforward;
 use crate::output::CliError;
 use crate::run::{run, Run, RunOptions};
 use crate::simulate::LOG_RATE_HZ;
 use closed_loop::{by_name, Scenario};
-use firmware::compensation::Table;
 use plant_model::Rig;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
@@ -159,12 +159,12 @@ pub fn hold() -> Result<&'static Scenario, CliError> {
         .ok_or_else(|| CliError::Failed("pressure-hold scenario missing".into()))
 }
 
-/// One holding run on `plant`, its controller configured from `controller`, with `table`
+/// One holding run on `plant`, its controller configured from `controller`, with `ff`
 /// loaded (or none), for [`HOLD_S`].
 pub fn holding(
     plant: &Rig,
     controller: &Rig,
-    table: Option<&Table>,
+    ff: Option<&Feedforward>,
 ) -> Result<Pulsation, CliError> {
     let scenario = hold()?;
     let r = run(
@@ -177,20 +177,20 @@ pub fn holding(
             seed: 1,
             progress: false,
             metadata: Vec::new(),
-            compensation: table.cloned(),
+            compensation: ff.cloned(),
         },
     )
     .map_err(CliError::Failed)?;
     Ok(measure(&r, scenario))
 }
 
-/// Holding runs on `plant` without the table and with each of `tables`, in parallel.
+/// Holding runs on `plant` without a feed-forward and with each of `tables`, in parallel.
 pub fn without_and_with(
     plant: &Rig,
     controller: &Rig,
-    tables: &[&Table],
+    tables: &[&Feedforward],
 ) -> Result<(Pulsation, Vec<Pulsation>), CliError> {
-    let jobs: Vec<Option<&Table>> = std::iter::once(None)
+    let jobs: Vec<Option<&Feedforward>> = std::iter::once(None)
         .chain(tables.iter().map(|t| Some(*t)))
         .collect();
     let mut out = jobs

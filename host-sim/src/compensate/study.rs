@@ -10,14 +10,14 @@
 //! Every run is the firmware's control core against the plant through `closed_loop`. The
 //! learning logs use other noise seeds than the evaluation.
 
+use super::flow::FlowParams;
 use super::predict::{self, Pulsation};
-use super::{find, model, table, table_of, Method};
+use super::{feedforward_of, find, model, table, Feedforward, Method};
 use crate::bench_log::BenchLog;
 use crate::output::CliError;
 use crate::run::{run, RunOptions};
 use closed_loop::scenario::HOLD_PRESSURE_PA;
 use closed_loop::{by_name, Scenario, ScenarioKind};
-use firmware::compensation::Table;
 use firmware::{Command, Mode};
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::{Effect, Rig};
@@ -115,12 +115,12 @@ fn learning_log(
 
 /// The bench procedure's learning on `plant` (controller configured from `rig`): the
 /// drive's sweep and a hold at 5 MPa of `hold_s`, logged at 1 kHz, and the model-based
-/// table learned from them.
+/// feed-forward learned from them (table and speed modulation).
 pub fn bench_learning(
     rig: &Rig,
     plant: &Rig,
     hold_s: f64,
-) -> Result<(Table, Vec<BenchLog>), CliError> {
+) -> Result<(Feedforward, Vec<BenchLog>), CliError> {
     let scenario =
         |name| by_name(name).ok_or_else(|| CliError::Failed(format!("scenario {name} missing")));
     let jobs = [
@@ -132,24 +132,29 @@ pub fn bench_learning(
         .map(|(sc, d, seed)| learning_log(plant, rig, sc, *d, *seed, true))
         .collect::<Result<Vec<_>, _>>()?;
     let found = find(&logs, rig)?;
-    let table = table_of(&found, &logs, rig, Method::Model, &[])?;
-    Ok((table, logs))
+    let ff = feedforward_of(&found, &logs, rig, Method::Model, &[])?;
+    Ok((ff, logs))
 }
 
-/// The tables one effect level learns.
+/// The feed-forwards one effect level learns.
 pub struct Tables {
-    /// Model-based, from the bench sweep and a hold at 5 MPa.
-    pub model: Table,
-    /// The same without the pump's ripple (which evens out the pump's flow).
-    pub model_without_pump: Table,
+    /// Model-based, from the bench sweep and a hold at 5 MPa: table and speed modulation.
+    pub model: Feedforward,
+    /// The same table without the speed modulation.
+    pub model_torque_only: Feedforward,
+    /// The same without the pump's ripple (which evens out the pump's flow): no
+    /// modulation either.
+    pub model_without_pump: Feedforward,
     /// The histogram method on the same logs.
-    pub histogram: Table,
+    pub histogram: Feedforward,
     /// Model-based from the bench sweep alone (low pressure only).
-    pub sweep_only: Table,
+    pub sweep_only: Feedforward,
     /// Model-based from a foreign-style log alone (no voltages).
-    pub foreign: Table,
-    /// The rig's own equations (the ideal).
-    pub ideal: Table,
+    pub foreign: Feedforward,
+    /// The rig's own equations (the ideal): table and modulation.
+    pub ideal: Feedforward,
+    /// The ideal table without the modulation.
+    pub ideal_torque_only: Feedforward,
 }
 
 /// Learns every table of one effect level on `plant` (controller configured from `rig`).
@@ -175,32 +180,59 @@ pub fn learn_tables(rig: &Rig, plant: &Rig) -> Result<Tables, CliError> {
     let foreign_found = find(std::slice::from_ref(foreign), rig)?;
     let ideal = table::build(&model::channels_from_rig(plant, rig.fill.pressure_pa, &[]))
         .ok_or_else(|| CliError::Failed("the ideal table does not fit".into()))?;
+    let ideal_flow = FlowParams::of_rig(plant).map(|f| FlowParams {
+        inertia_kg_m2: plant.shaft.inertia_kg_m2(),
+        ..f
+    });
     Ok(Tables {
-        model: table_of(&found, &bench, rig, Method::Model, &none)?,
-        model_without_pump: table_of(
+        model: feedforward_of(&found, &bench, rig, Method::Model, &none)?,
+        model_torque_only: feedforward_of(
+            &found,
+            &bench,
+            rig,
+            Method::Model,
+            &[super::flow::EXCLUDE_NAME.to_string()],
+        )?,
+        model_without_pump: feedforward_of(
             &found,
             &bench,
             rig,
             Method::Model,
             &["piston_ripple".to_string()],
         )?,
-        histogram: table_of(&found, &bench, rig, Method::Histogram, &none)?,
-        sweep_only: table_of(
+        histogram: feedforward_of(&found, &bench, rig, Method::Histogram, &none)?,
+        sweep_only: feedforward_of(
             &sweep_found,
             std::slice::from_ref(sweep),
             rig,
             Method::Model,
             &none,
         )?,
-        foreign: table_of(
+        foreign: feedforward_of(
             &foreign_found,
             std::slice::from_ref(foreign),
             rig,
             Method::Model,
             &none,
         )?,
-        ideal,
+        ideal: Feedforward {
+            table: ideal.clone(),
+            flow: ideal_flow,
+        },
+        ideal_torque_only: Feedforward::table_only(ideal),
     })
+}
+
+/// `ff` with its speed modulation's phase moved by `cycle_deg` [°] of the ripple's cycle
+/// (the phase error a pump mounted off the encoder's reference would leave).
+pub fn with_flow_phase(ff: &Feedforward, cycle_deg: f64) -> Feedforward {
+    let mut out = ff.clone();
+    if let Some(f) = &mut out.flow {
+        let order = plant_model::pump::ripple_order(f.pistons) as f64;
+        f.phase_rad =
+            (f.phase_rad + cycle_deg.to_radians() / order).rem_euclid(std::f64::consts::TAU);
+    }
+    out
 }
 
 /// One row of the study: a table (or none) on a plant.
@@ -233,12 +265,23 @@ pub fn rows_for(rig: &Rig, level: f64) -> Result<Vec<Row>, CliError> {
             r
         };
         let controller = fit(rig);
-        let cases: Vec<(&str, Rig, Option<&Table>)> = vec![
+        let late = with_flow_phase(&t.model, 10.0);
+        let cases: Vec<(&str, Rig, Option<&Feedforward>)> = vec![
             ("none", fit(&plant), None),
             (
-                "model (bench sweep + 5 MPa hold)",
+                "model + speed modulation (bench sweep + 5 MPa hold)",
                 fit(&plant),
                 Some(&t.model),
+            ),
+            (
+                "model, torque table only",
+                fit(&plant),
+                Some(&t.model_torque_only),
+            ),
+            (
+                "model + modulation 10° (of the ripple cycle) late",
+                fit(&plant),
+                Some(&late),
             ),
             (
                 "model without the pump's ripple",
@@ -257,9 +300,14 @@ pub fn rows_for(rig: &Rig, level: f64) -> Result<Vec<Row>, CliError> {
                 Some(&t.foreign),
             ),
             (
-                "ideal (the rig's own equations)",
+                "ideal (the rig's own equations) + modulation",
                 fit(&plant),
                 Some(&t.ideal),
+            ),
+            (
+                "ideal torque table only",
+                fit(&plant),
+                Some(&t.ideal_torque_only),
             ),
             ("none, effects +10 %, +10°", fit(&plus), None),
             ("model on effects +10 %, +10°", fit(&plus), Some(&t.model)),

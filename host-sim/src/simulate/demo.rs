@@ -5,6 +5,7 @@
 
 use super::holding::pulsation;
 use super::{converged, effects_text, plant_rig, rig_name, write_log, LOG_RATE_HZ};
+use crate::compensate::Feedforward;
 use crate::output::paths::{replaceable, Declared};
 use crate::output::{print_stdout, CliError};
 use crate::plots::{line_chart, stacked_chart, Marker, Panel, Series};
@@ -12,8 +13,6 @@ use crate::pulsation::sources;
 use crate::run::{run, Run, RunOptions};
 use clap::Args;
 use closed_loop::{by_name, Scenario};
-use firmware::compensation::record::{Encoder, RECORD_LEN};
-use firmware::compensation::Table;
 use plant_model::effects::paper_low_speed_effects;
 use plant_model::{Effect, Rig};
 use rayon::prelude::*;
@@ -61,7 +60,7 @@ type Job<'a> = (
     &'a Scenario,
     f64,
     Vec<(String, String)>,
-    Option<&'a Table>,
+    Option<&'a Feedforward>,
 );
 
 /// `eha demo`.
@@ -99,8 +98,8 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             ("absorber".into(), absorber.into()),
         ]
     };
-    // The torque feed-forward learned as a bench would: the drive's sweep and a 12 s hold
-    // at 5 MPa, `eha compensate`'s model method.
+    // The torque feed-forward and the speed modulation learned as a bench would: the
+    // drive's sweep and a 12 s hold at 5 MPa, `eha compensate`'s model method.
     let (ff_table, ff_logs) = crate::compensate::study::bench_learning(rig, &plant, 12.0)?;
     // In parallel: holding with and without the absorber, each without and with the
     // feed-forward, a pressure step and a speed step.
@@ -186,12 +185,12 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     let po = pulsation(&without, hold, &plant);
     let pwf = pulsation(&with_ff, hold, &plant);
     let pof = pulsation(&without_ff, hold, &plant);
-    let mut record = [0u8; RECORD_LEN];
-    Encoder::write_all(&ff_table, &mut record);
     let table_path = out.join("compensation.table");
-    crate::output::atomic::write(&table_path, &record).map_err(|source| CliError::Write {
-        file: table_path.clone(),
-        source,
+    crate::output::atomic::write(&table_path, &ff_table.file_bytes()).map_err(|source| {
+        CliError::Write {
+            file: table_path.clone(),
+            source,
+        }
     })?;
     write_log(&out.join("compensation-sweep.csv"), &ff_logs[0])?;
 
@@ -257,7 +256,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         |without: f64, with: f64| crate::compensate::predict::reduction_percent(without, with);
     let _ = writeln!(
         table,
-        "torque feed-forward (learned by the bench sweep and a 12 s hold, compensation.table): pulsation {:.0} % less without the absorber, {:.0} % less with it; the rest is the pump's flow ripple and the loop's wander (docs/compensation.md)",
+        "torque feed-forward and speed modulation against the pump's flow ripple (learned by the bench sweep and a 12 s hold, compensation.table): pulsation {:.0} % less without the absorber, {:.0} % less with it; what is left: docs/compensation.md",
         cut(po.pp_pa, pof.pp_pa),
         cut(pw.pp_pa, pwf.pp_pa)
     );

@@ -283,9 +283,16 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         metadata.push((
             "compensation".into(),
             format!(
-                "{} (CRC {:#010x})",
+                "{} (CRC {:#010x}; speed modulation {})",
                 path.display(),
-                firmware::compensation::record::crc_of(t)
+                firmware::compensation::record::crc_of(&t.table),
+                match &t.flow {
+                    Some(f) => format!(
+                        "{} pistons, {:.4} peak-to-peak, phase {} rad",
+                        f.pistons, f.ratio, f.phase_rad
+                    ),
+                    None => "off".into(),
+                }
             ),
         ));
     }

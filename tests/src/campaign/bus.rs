@@ -126,11 +126,12 @@ impl Garbage {
                 (0x100 | node, 1)
             }
             4 => {
-                // Parameter ids 0, 6-9, 16-19 ... are unassigned: 0 and ≥ 55 are always.
-                bytes[0] = if self.rng.next_u64() % 2 == 0 {
-                    0
-                } else {
-                    55 + (self.rng.next_u64() % 200) as u8
+                // A byte that is no parameter's id (0, 6-9, 16-19, …, above the last).
+                bytes[0] = loop {
+                    let b = self.rng.next_u64() as u8;
+                    if firmware::parameters::ParamId::from_code(b).is_none() {
+                        break b;
+                    }
                 };
                 let base = if self.rng.next_u64() % 2 == 0 {
                     0x200
