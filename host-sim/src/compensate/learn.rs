@@ -31,7 +31,7 @@
 //! counts only the one with the largest total Λ is kept; of cogging orders likewise.
 
 use crate::bench_log::BenchLog;
-use crate::diagnose::analysis::diagnose;
+use crate::diagnose::analysis::{diagnose_to, Precision};
 use crate::diagnose::diagnosis::Cause;
 use crate::output::CliError;
 use plant_model::{Effect, Rig};
@@ -94,7 +94,9 @@ fn significant(causes: Vec<Cause>) -> Vec<Cause> {
 /// may not (too short a log for it), and then adds nothing.
 pub fn causes_of(log: &BenchLog, rig: &Rig) -> Result<Vec<Vec<Cause>>, CliError> {
     let half = log.tail(log.len() / 2);
-    let (whole, second) = rayon::join(|| diagnose(log, rig), || diagnose(&half, rig));
+    // The table is built from the fitted parameters themselves: the fits run to the end.
+    let learn = |l: &BenchLog| diagnose_to(l, rig, Precision::Learning);
+    let (whole, second) = rayon::join(|| learn(log), || learn(&half));
     let whole =
         whole.map_err(|e| CliError::Failed(format!("the diagnosis of the log failed: {e}")))?;
     let mut out = vec![significant(whole.causes)];

@@ -15,7 +15,7 @@
 
 use super::angle_locked::ShaftConstants;
 use super::calibration::{
-    calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Release,
+    calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Patient, Release,
     HYDRAULIC_WINDOW_S,
 };
 use super::candidates::{test_lines, test_relation, Extension, Tested};
@@ -24,6 +24,7 @@ use super::decision::{apply_vetoes, decide};
 use super::diagnosis::Diagnosis;
 use super::electrical::ElectricalRelation;
 use super::facts::LogFacts;
+use super::least_squares::{PATIENCE, THOROUGH_PATIENCE};
 use super::lines::window_lines;
 use super::mechanical::ShaftMotion;
 use super::predictions::{predict, Context, ModelValues};
@@ -68,6 +69,15 @@ pub fn diagnose(log: &BenchLog, rig: &Rig) -> Result<Diagnosis, DiagnoseError> {
     analyse(log, rig).map(|a| a.diagnosis)
 }
 
+/// Diagnoses `log` against `rig` with the fits driven to `precision`.
+pub fn diagnose_to(
+    log: &BenchLog,
+    rig: &Rig,
+    precision: Precision,
+) -> Result<Diagnosis, DiagnoseError> {
+    analyse_reporting(log, rig, precision, &|_: &'static str| {}).map(|a| a.diagnosis)
+}
+
 /// The orders the lines are read at: a current offset's p_n, flux harmonics' and dead
 /// time's 6·p_n, the pumps' 2z and the rig's slot order.
 fn line_orders(rig: &Rig) -> Vec<u32> {
@@ -106,9 +116,18 @@ fn reported<T>(progress: &dyn Progress, value: T, next: &'static str) -> T {
 /// relations' tests, the lines' tests, the predictions and the evidence.
 pub const STEPS: u64 = 13;
 
+/// How far the fits are driven.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// Until the decision is settled: `eha diagnose`.
+    Diagnosis,
+    /// Until the fitted parameters stop moving: a feed-forward learned from them.
+    Learning,
+}
+
 /// Runs the whole diagnosis.
 pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
-    analyse_reporting(log, rig, &|_: &'static str| {})
+    analyse_reporting(log, rig, Precision::Diagnosis, &|_: &'static str| {})
 }
 
 /// The log's windows and the parity relations it supports.
@@ -122,6 +141,8 @@ pub(super) struct Relations<'a> {
     pub(super) electrical: Option<ElectricalRelation<'a>>,
     pub(super) cylinder: Option<CylinderRelation<'a>>,
     pub(super) orders: Vec<u32>,
+    /// The optimiser's patience on every relation.
+    pub(super) patience: usize,
 }
 
 impl<'a> Relations<'a> {
@@ -130,6 +151,7 @@ impl<'a> Relations<'a> {
         facts: &'a LogFacts,
         motion: &'a ShaftMotion,
         rig: &'a Rig,
+        precision: Precision,
     ) -> Relations<'a> {
         let windows = |rows, length, signal: &[f64]| thinned(facts.windows(rows, length), signal);
         let orders = line_orders(rig);
@@ -147,6 +169,18 @@ impl<'a> Relations<'a> {
             electrical: ElectricalRelation::of(log, facts, rig),
             cylinder: CylinderRelation::of(log, facts, rig),
             orders,
+            patience: match precision {
+                Precision::Diagnosis => PATIENCE,
+                Precision::Learning => THOROUGH_PATIENCE,
+            },
+        }
+    }
+
+    /// `relation` fitted with the precision's patience.
+    fn patient<'r, R>(&self, relation: &'r R) -> Patient<'r, R> {
+        Patient {
+            relation,
+            patience: self.patience,
         }
     }
 }
@@ -165,18 +199,24 @@ fn calibrate_all(r: &Relations<'_>, progress: &dyn Progress) -> Calibrations {
     let ((hydraulic, mechanical), (electrical, cylinder)) = rayon::join(
         || {
             rayon::join(
-                || done(calibrate(&r.hydraulic, &r.h_id), "calibration"),
-                || done(calibrate(&r.mechanical, &r.m_id), "calibration"),
+                || done(calibrate(&r.patient(&r.hydraulic), &r.h_id), "calibration"),
+                || done(calibrate(&r.patient(&r.mechanical), &r.m_id), "calibration"),
             )
         },
         || {
             rayon::join(
                 || {
-                    let c = r.electrical.as_ref().map(|e| calibrate(e, &r.m_id));
+                    let c = r
+                        .electrical
+                        .as_ref()
+                        .map(|e| calibrate(&r.patient(e), &r.m_id));
                     reported(progress, c, "calibration")
                 },
                 || {
-                    let c = r.cylinder.as_ref().map(|c| calibrate(c, &r.m_id));
+                    let c = r
+                        .cylinder
+                        .as_ref()
+                        .map(|c| calibrate(&r.patient(c), &r.m_id));
                     reported(progress, c, "calibration")
                 },
             )
@@ -213,12 +253,20 @@ fn test_relations(
         || {
             rayon::join(
                 || {
-                    let t = test_relation(&r.hydraulic, h, &r.h_id, &r.h_val, &hyd_releases, rig);
+                    let t = test_relation(
+                        &r.patient(&r.hydraulic),
+                        h,
+                        &r.h_id,
+                        &r.h_val,
+                        &hyd_releases,
+                        rig,
+                    );
                     reported(progress, t, "testing effects")
                 },
                 || {
                     let rel = [Release::ShaftFriction];
-                    let t = test_relation(&r.mechanical, m, &r.m_id, &r.m_val, &rel, rig);
+                    let t =
+                        test_relation(&r.patient(&r.mechanical), m, &r.m_id, &r.m_val, &rel, rig);
                     reported(progress, t, "testing effects")
                 },
             )
@@ -227,9 +275,14 @@ fn test_relations(
             rayon::join(
                 || {
                     let t = match (&r.electrical, &cal.electrical) {
-                        (Some(e), Some(c)) => {
-                            test_relation(e, c, &r.m_id, &r.m_val, &[Release::DeadTime], rig)
-                        }
+                        (Some(e), Some(c)) => test_relation(
+                            &r.patient(e),
+                            c,
+                            &r.m_id,
+                            &r.m_val,
+                            &[Release::DeadTime],
+                            rig,
+                        ),
                         _ => Vec::new(),
                     };
                     reported(progress, t, "testing effects")
@@ -237,7 +290,9 @@ fn test_relations(
                 || {
                     let rel = [Release::CylinderFriction];
                     let t = match (&r.cylinder, &cal.cylinder) {
-                        (Some(y), Some(c)) => test_relation(y, c, &r.m_id, &r.m_val, &rel, rig),
+                        (Some(y), Some(c)) => {
+                            test_relation(&r.patient(y), c, &r.m_id, &r.m_val, &rel, rig)
+                        }
                         _ => Vec::new(),
                     };
                     reported(progress, t, "testing effects")
@@ -255,6 +310,7 @@ fn test_relations(
 pub fn analyse_reporting(
     log: &BenchLog,
     rig: &Rig,
+    precision: Precision,
     progress: &dyn Progress,
 ) -> Result<Analysis, DiagnoseError> {
     log.check(Path::new("bench log being diagnosed"))?;
@@ -262,7 +318,7 @@ pub fn analyse_reporting(
     // 1. Facts.
     let facts = LogFacts::of(log, rig);
     let motion = ShaftMotion::of(log, &facts);
-    let rel = Relations::of(log, &facts, &motion, rig);
+    let rel = Relations::of(log, &facts, &motion, rig, precision);
     progress.step("calibration");
     // 2. Calibration.
     let cal = calibrate_all(&rel, progress);

@@ -29,7 +29,7 @@ use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::facts::LogFacts;
 use crate::diagnose::hydraulic::{HydraulicInputs, HydraulicParams, Hydraulics};
 use crate::diagnose::least_squares::{
-    fit, huber, variance_per_independent_sample, Fitted, ParamSpec,
+    fit_with_patience, huber, variance_per_independent_sample, Fitted, ParamSpec, PATIENCE,
 };
 use crate::diagnose::mechanical::{MechanicalParams, Mechanics, ShaftMotion};
 use nalgebra::{DMatrix, DVector};
@@ -408,6 +408,10 @@ pub trait Relation: Sync {
     /// precharge far off is half-mimicked by displacement and shell volume); `None` when
     /// the relation does not offer `release`.
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)>;
+    /// The optimiser's patience on this relation (iterations per parameter).
+    fn patience(&self) -> usize {
+        PATIENCE
+    }
 }
 
 /// `nominal` times each of `factors`.
@@ -423,6 +427,29 @@ pub struct HydraulicRelation<'a> {
     pub facts: &'a LogFacts,
     /// The rig file.
     pub rig: &'a Rig,
+}
+
+/// A relation fitted with another optimiser patience than [`PATIENCE`].
+pub struct Patient<'r, R> {
+    /// The relation.
+    pub relation: &'r R,
+    /// Iterations per parameter.
+    pub patience: usize,
+}
+
+impl<R: Relation> Relation for Patient<'_, R> {
+    fn specs(&self, release: Release) -> Vec<ParamSpec> {
+        self.relation.specs(release)
+    }
+    fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
+        self.relation.residuals(values, rows)
+    }
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        self.relation.released(release)
+    }
+    fn patience(&self) -> usize {
+        self.patience
+    }
 }
 
 impl Relation for HydraulicRelation<'_> {
@@ -565,7 +592,7 @@ pub fn fit_relation<R: Relation>(
         r.iter_mut().for_each(|x| *x *= w);
         r
     };
-    fit(&model, &specs)
+    fit_with_patience(&model, &specs, relation.patience())
 }
 
 /// Calibrates `relation` within its bands over `rows`: weighed first by the nominal

@@ -1,7 +1,7 @@
 //! `eha diagnose LOG.csv [--json PATH] [--report DIR]`: reads the log, diagnoses it against
 //! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
-use super::analysis::{analyse_reporting, STEPS};
+use super::analysis::{analyse_reporting, Precision, STEPS};
 use super::DiagnoseError;
 use crate::output::paths::Declared;
 use crate::output::{print_stdout, write_json, CliError};
@@ -66,7 +66,7 @@ pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
         format!("diagnosing {} ({} rows)", args.log.display(), log.len()),
     );
     bar.set_prefix("facts");
-    let analysis = analyse_reporting(&log, rig, &|next: &'static str| {
+    let analysis = analyse_reporting(&log, rig, Precision::Diagnosis, &|next: &'static str| {
         bar.inc(1);
         bar.set_prefix(next);
     });

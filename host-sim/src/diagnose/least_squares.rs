@@ -321,7 +321,11 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
 /// displacement and volume) along which the optimiser creeps by hundredths of a noise unit
 /// per iteration long after the decision's differences (χ² thresholds of 15–18 units) are
 /// settled: ten per parameter bound that creep and leave the decisions as they were.
-const PATIENCE: usize = 10;
+pub const PATIENCE: usize = 10;
+
+/// The patience of a fit whose parameters are used, not only compared (a feed-forward
+/// learned from them): the creep along the valleys is followed to its end.
+pub const THOROUGH_PATIENCE: usize = 25;
 
 /// Relative reduction of the objective (and of the step) below which the optimiser stops:
 /// on objectives of 10⁴–10⁵ noise units a millionth is a tenth of a unit, far below the
@@ -330,6 +334,11 @@ const FTOL: f64 = 1e-6;
 
 /// Fits `specs` to `model` from their starts.
 pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
+    fit_with_patience(model, specs, PATIENCE)
+}
+
+/// [`fit`] with the optimiser's `patience` (iterations per parameter).
+pub fn fit_with_patience<M: Model>(model: &M, specs: &[ParamSpec], patience: usize) -> Fitted {
     // A start on a bound would freeze the search there (the sine transform is flat at its
     // ends): every start at least 1 % of the range inside.
     let v0 = DVector::from_iterator(
@@ -351,7 +360,7 @@ pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
         (problem, None)
     } else {
         let (p, r) = LevenbergMarquardt::<f64>::new()
-            .with_patience(PATIENCE)
+            .with_patience(patience)
             .with_ftol(FTOL)
             .with_xtol(FTOL)
             .minimize(problem);
