@@ -35,8 +35,10 @@ pub const STEADY_MAX_S: f64 = 4.0;
 /// Chunk whose mean speed the steady windows are built from. [s]
 pub const STEADY_CHUNK_S: f64 = 0.1;
 
-/// Largest departure of a chunk's mean speed from its window's mean, relative to it. [1]
-pub const STEADY_SPREAD: f64 = 0.1;
+/// Largest departure of a chunk's mean speed from its window's mean, relative to it: wide
+/// enough to take the slow holding, whose pressure loop makes the shaft's speed wander by
+/// a fifth about its mean, while a speed step or a stroke's start still cuts a window. [1]
+pub const STEADY_SPREAD: f64 = 0.25;
 
 /// Fewest mechanical revolutions a steady window must hold for its lines to be resolved
 /// (over one revolution orders k and k ± 1 are orthogonal). [1]
