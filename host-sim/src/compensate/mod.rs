@@ -12,6 +12,7 @@
 //! - [`predict`]: holding runs without and with a table, their pulsation.
 //! - [`can`]: the loading frames in `cansend` notation.
 //! - [`study`]: the closed-loop study of `docs/compensation.md`.
+//! - `summary`: the printed summary and the JSON of a run.
 //!
 //! More than one log may be given (the contract's one `LOG.csv` is the common case): the
 //! bench sweep at low pressure carries the load-independent lines, a hold at working
@@ -24,20 +25,20 @@ pub mod learn;
 pub mod model;
 pub mod predict;
 pub mod study;
+mod summary;
 pub mod table;
 
 use crate::bench_log::{self, BenchLog};
 use crate::output::paths::Declared;
 use crate::output::{print_stdout, write_json, CliError};
 use clap::{Args, ValueEnum};
+use firmware::can_protocol::{Frame, NodeId};
 use firmware::compensation::record::{self, RECORD_LEN};
-use firmware::compensation::{Channel, Compensation, Table, BINS, CHANNELS};
+use firmware::compensation::{Compensation, Table, BINS, CHANNELS};
 use flow::FlowParams;
 use learn::Learned;
 use plant_model::Rig;
-use predict::reduction_percent;
-use serde_json::json;
-use std::fmt::Write as _;
+use predict::Pulsation;
 use std::path::PathBuf;
 
 /// How the table is learned.
@@ -300,197 +301,114 @@ pub fn fitted_plant(found: &Found, rig: &Rig) -> Result<Rig, CliError> {
     Ok(plant)
 }
 
-/// One line per learned effect: name, Λ, logs, fitted parameters.
-fn effect_lines(effects: &[Learned]) -> String {
-    let mut s = String::from("effect                      Λ  fits  parameters\n");
-    for l in effects {
-        let params: Vec<String> = l
-            .effect
-            .parameters()
-            .iter()
-            .flatten()
-            .map(|(k, v)| format!("{k}={v:.4e}"))
-            .collect();
-        let _ = writeln!(
-            s,
-            "{:<22} {:>7.0} {:>5}  {}",
-            l.effect.name(),
-            l.score,
-            l.diagnoses,
-            params.join(" ")
-        );
-    }
-    if effects.is_empty() {
-        s.push_str("(none significant: the table is empty)\n");
-    }
-    s
+/// What one run learned from the logs and predicted of it on the paper's holding.
+struct Outcome {
+    /// What the diagnosis found in the logs.
+    found: Found,
+    /// The feed-forward learned.
+    ff: Feedforward,
+    /// The holding's pulsation on the fitted plant without the feed-forward.
+    without: Pulsation,
+    /// The same with it.
+    with: Pulsation,
 }
 
-/// `eha compensate`.
-pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> {
-    if let Some(bad) = args
-        .exclude
+/// Checks `--exclude`: each name an angle-locked effect or [`flow::EXCLUDE_NAME`].
+fn check_exclude(exclude: &[String]) -> Result<(), CliError> {
+    match exclude
         .iter()
         .find(|x| !learn::LINE_EFFECTS.contains(&x.as_str()) && *x != flow::EXCLUDE_NAME)
     {
-        return Err(CliError::BadInput(format!(
+        Some(bad) => Err(CliError::BadInput(format!(
             "--exclude `{bad}`: not an angle-locked effect (one of {}) or {}",
             learn::LINE_EFFECTS.join(", "),
             flow::EXCLUDE_NAME
-        )));
+        ))),
+        None => Ok(()),
     }
-    let logs = read_logs(rig, args)?;
+}
+
+/// Learns the feed-forward from `logs` by `args.method` and predicts its effect on the
+/// holding against the plant fitted to the logs, under a progress spinner.
+fn learn_and_predict(
+    rig: &Rig,
+    logs: &[BenchLog],
+    args: &CompensateArgs,
+) -> Result<Outcome, CliError> {
     let busy = crate::output::progress::spinner(format!(
         "learning the feed-forward from {} log(s)",
         logs.len()
     ));
     let learned = (|| {
-        let found = find(&logs, rig)?;
-        let ff = feedforward_of(&found, &logs, rig, args.method, &args.exclude)?;
+        let found = find(logs, rig)?;
+        let ff = feedforward_of(&found, logs, rig, args.method, &args.exclude)?;
         let plant = fitted_plant(&found, rig)?;
         let (without, with) = predict::without_and_with(&plant, rig, &[&ff])?;
         let with = with
             .into_iter()
             .next()
             .ok_or_else(|| CliError::Failed("no run with the table".into()))?;
-        Ok::<_, CliError>((found, ff, without, with))
+        Ok::<_, CliError>(Outcome {
+            found,
+            ff,
+            without,
+            with,
+        })
     })();
     busy.finish_and_clear();
-    let (found, ff, without, with) = learned?;
-    let table = &ff.table;
-    let bytes = ff.file_bytes();
-    crate::output::atomic::write(&args.out, &bytes).map_err(|source| CliError::Write {
-        file: args.out.clone(),
+    learned
+}
+
+/// Writes the table file (`bytes`) to `path` atomically.
+fn write_table_file(path: &std::path::Path, bytes: &[u8]) -> Result<(), CliError> {
+    crate::output::atomic::write(path, bytes).map_err(|source| CliError::Write {
+        file: path.to_path_buf(),
         source,
-    })?;
-    let node = firmware::can_protocol::NodeId::new(crate::tune::can::NODE)
-        .map_err(|e| CliError::Failed(format!("CAN node: {e:?}")))?;
-    let frames = can::frames(&ff, node);
-    let peak = table.peak();
-    let mut text = String::new();
-    let _ = writeln!(
-        text,
-        "{} method from {} log(s); effects learned:",
-        args.method.name(),
-        logs.len()
-    );
-    let in_table: Vec<Learned> = found
-        .effects
+    })
+}
+
+/// Writes `frames` to `path` as a `candump -l` log.
+fn write_can_log(path: &std::path::Path, frames: &[Frame]) -> Result<(), CliError> {
+    let commands: Vec<crate::can_commands::CanCommand> = frames
         .iter()
-        .filter(|l| !args.exclude.iter().any(|x| x == l.effect.name()))
-        .cloned()
+        .map(|f| crate::can_commands::CanCommand {
+            frame: *f,
+            what: "compensation table".into(),
+        })
         .collect();
-    text.push_str(&effect_lines(&in_table));
-    if in_table.len() < found.effects.len() {
-        let _ = writeln!(text, "(left out of the table: {})", args.exclude.join(", "));
-    }
-    let _ = writeln!(
-        text,
-        "table: {BINS} bins; peaks {:.4} A, {:.3e} A/Pa, {:.4} A/A; written to {} ({} bytes, record CRC {:#010x})",
-        peak[Channel::Constant as usize],
-        peak[Channel::PerPressure as usize],
-        peak[Channel::PerCurrent as usize],
-        args.out.display(),
-        bytes.len(),
-        record::crc_of(table)
-    );
-    match &ff.flow {
-        Some(f) => {
-            let _ = writeln!(
-                text,
-                "speed modulation against the pump's flow ripple: {} pistons, {:.3} % peak-to-peak, phase {:.3} rad, J = {:.3e} kg·m²",
-                f.pistons,
-                100.0 * f.ratio,
-                f.phase_rad,
-                f.inertia_kg_m2
-            );
-        }
-        None => {
-            let _ = writeln!(text, "speed modulation against the pump's flow ripple: off");
-        }
-    }
-    let _ = writeln!(
-        text,
-        "predicted, holding at 5 MPa on the rig with the learned effects (true signals, steady part):"
-    );
-    let _ = writeln!(
-        text,
-        "                          without       with  reduction"
-    );
-    for (name, w, t, unit) in [
-        (
-            "pressure pp",
-            without.pressure_pp_pa,
-            with.pressure_pp_pa,
-            "Pa",
-        ),
-        (
-            "pressure locked pp",
-            without.pressure_locked_pp_pa,
-            with.pressure_locked_pp_pa,
-            "Pa",
-        ),
-        (
-            "speed pp",
-            without.speed_pp_rad_s,
-            with.speed_pp_rad_s,
-            "rad/s",
-        ),
-        (
-            "speed locked pp",
-            without.speed_locked_pp_rad_s,
-            with.speed_locked_pp_rad_s,
-            "rad/s",
-        ),
-    ] {
-        let _ = writeln!(
-            text,
-            "  {name:<20} {w:>10.3} {t:>10.3} {:>8.0} %  [{unit}]",
-            reduction_percent(w, t)
-        );
-    }
-    let _ = writeln!(
-        text,
-        "CAN frames loading, enabling and saving it on node {} ({} frames):",
-        node.get(),
-        frames.len()
-    );
-    text.push_str(&can::cansend_lines(&frames));
-    print_stdout(&text)?;
+    crate::can_commands::write_candump_log(path, &commands)
+}
+
+/// `eha compensate`: checks the arguments and logs, learns the feed-forward, writes the
+/// table, prints the summary and the CAN frames, then writes the CAN log and the JSON if
+/// asked for.
+pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> {
+    check_exclude(&args.exclude)?;
+    let logs = read_logs(rig, args)?;
+    let outcome = learn_and_predict(rig, &logs, args)?;
+    let bytes = outcome.ff.file_bytes();
+    write_table_file(&args.out, &bytes)?;
+    let node = NodeId::new(crate::tune::can::NODE)
+        .map_err(|e| CliError::Failed(format!("CAN node: {e:?}")))?;
+    let frames = can::frames(&outcome.ff, node);
+    let in_table = summary::in_table(&outcome, &args.exclude);
+    let written = summary::Written {
+        file_len: bytes.len(),
+        node,
+        frames: &frames,
+    };
+    print_stdout(&summary::text(
+        args,
+        logs.len(),
+        &outcome,
+        &in_table,
+        &written,
+    ))?;
     if let Some(path) = &args.can_log {
-        let commands: Vec<crate::can_commands::CanCommand> = frames
-            .iter()
-            .map(|f| crate::can_commands::CanCommand {
-                frame: *f,
-                what: "compensation table".into(),
-            })
-            .collect();
-        crate::can_commands::write_candump_log(path, &commands)?;
+        write_can_log(path, &frames)?;
     }
     if let Some(path) = &args.json {
-        write_json(
-            path,
-            &json!({
-                "method": args.method.name(),
-                "effects": in_table.iter().map(|e| e.effect.name()).collect::<Vec<_>>(),
-                "table_bins": BINS,
-                "predicted": {
-                    "pressure_pp_pa": {"without": without.pressure_pp_pa, "with": with.pressure_pp_pa},
-                    "speed_pp_rad_s": {"without": without.speed_pp_rad_s, "with": with.speed_pp_rad_s},
-                    "pressure_angle_locked_pp_pa": {"without": without.pressure_locked_pp_pa, "with": with.pressure_locked_pp_pa},
-                    "speed_angle_locked_pp_rad_s": {"without": without.speed_locked_pp_rad_s, "with": with.speed_locked_pp_rad_s},
-                },
-                "table_crc": record::crc_of(table),
-                "flow_ripple": ff.flow.map(|f| json!({
-                    "pistons": f.pistons,
-                    "ratio": f.ratio,
-                    "phase_rad": f.phase_rad,
-                    "inertia_kg_m2": f.inertia_kg_m2,
-                })),
-                "table_peaks": {"constant_a": peak[0], "per_pressure_a_per_pa": peak[1], "per_current": peak[2]},
-                "logs": args.logs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
-            }),
-        )?;
+        write_json(path, &summary::json(args, &outcome, &in_table))?;
     }
     Ok(())
 }

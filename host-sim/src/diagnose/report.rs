@@ -6,6 +6,8 @@
 //! of them are written, so a failure leaves DIR as it was.
 
 use super::analysis::Analysis;
+use super::diagnosis::Diagnosis;
+use super::spectrum::OrderSpectrum;
 use crate::output::CliError;
 use crate::plots::{line_chart, png, stacked_chart, Marker, Panel, Series};
 use std::fmt::Write as _;
@@ -124,10 +126,26 @@ pub fn write_report(dir: &Path, log_path: &Path, analysis: &Analysis) -> Result<
     result
 }
 
+/// Renders every file of the report into `dir`: the markdown's sections in order, the
+/// figures they link, then `report.md`. Returns the files written, for the move.
 fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliError> {
     let d = &a.diagnosis;
     let mut files = Vec::new();
     let mut md = String::new();
+    summary_section(&mut md, log_path, d);
+    ranking_section(&mut md, d);
+    signatures_section(&mut md, a);
+    trace_section(dir, &mut md, &mut files, a)?;
+    spectrum_section(dir, &mut md, &mut files, a)?;
+    crate::output::atomic::write(&dir.join("report.md"), md.as_bytes())
+        .map_err(|e| failed("report.md", e))?;
+    files.push("report.md".into());
+    Ok(files)
+}
+
+/// The title, the leading cause with its evidence, the segments, the per-signal fit table
+/// (baseline against extended, on the validation segment) and the pressure RMSE.
+fn summary_section(md: &mut String, log_path: &Path, d: &Diagnosis) {
     let lead = &d.causes[0];
     let _ = writeln!(md, "# Diagnosis of `{}`\n", log_path.display());
     let _ = writeln!(
@@ -164,6 +182,10 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
         "\nPressure RMSE: {:.0} Pa → {:.0} Pa ({:+.1} % reduction).\n",
         d.baseline.rmse_pa, d.extended.rmse_pa, d.gain.rmse_reduction_percent
     );
+}
+
+/// The ranking: every cause with its score, fitted parameters and evidence.
+fn ranking_section(md: &mut String, d: &Diagnosis) {
     let _ = writeln!(
         md,
         "## Ranking\n\n| rank | effect | score | parameters | evidence |\n|---|---|---|---|---|"
@@ -184,32 +206,46 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
             c.evidence
         );
     }
-    if !a.signatures.is_empty() {
+}
+
+/// The baseline residuals' time-domain signatures, when there are any.
+fn signatures_section(md: &mut String, a: &Analysis) {
+    if a.signatures.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Residual signatures (baseline, measured − simulated)\n\n\
+         | signal | RMS | Ljung–Box Q ({} lags) | p (white) | corr. speed | corr. pressure | \
+         corr. q current | lag [ms] | standstill / running RMS |\n|---|---|---|---|---|---|---|---|---|",
+        super::signatures::WHITENESS_LAGS
+    );
+    for g in &a.signatures {
         let _ = writeln!(
             md,
-            "\n## Residual signatures (baseline, measured − simulated)\n\n\
-             | signal | RMS | Ljung–Box Q ({} lags) | p (white) | corr. speed | corr. pressure | \
-             corr. q current | lag [ms] | standstill / running RMS |\n|---|---|---|---|---|---|---|---|---|",
-            super::signatures::WHITENESS_LAGS
+            "| `{}` | {:.4e} | {:.0} | {:.3} | {:+.2} | {:+.2} | {:+.2} | {:.1} | {} |",
+            g.signal,
+            g.rms,
+            g.ljung_box_q,
+            g.white_p,
+            g.corr_speed,
+            g.corr_pressure,
+            g.corr_current,
+            1e3 * g.lag_s,
+            g.standstill_ratio
+                .map_or("—".to_string(), |k| format!("{k:.2}"))
         );
-        for g in &a.signatures {
-            let _ = writeln!(
-                md,
-                "| `{}` | {:.4e} | {:.0} | {:.3} | {:+.2} | {:+.2} | {:+.2} | {:.1} | {} |",
-                g.signal,
-                g.rms,
-                g.ljung_box_q,
-                g.white_p,
-                g.corr_speed,
-                g.corr_pressure,
-                g.corr_current,
-                1e3 * g.lag_s,
-                g.standstill_ratio
-                    .map_or("—".to_string(), |k| format!("{k:.2}"))
-            );
-        }
     }
-    // Traces of every predicted signal.
+}
+
+/// One trace figure ([`trace_figure`]) per predicted signal that was also measured,
+/// written into `dir` and linked from the report.
+fn trace_section(
+    dir: &Path,
+    md: &mut String,
+    files: &mut Vec<String>,
+    a: &Analysis,
+) -> Result<(), CliError> {
     let signals: Vec<&'static str> = a.baseline.keys().copied().collect();
     let _ = writeln!(md, "\n## Measured and simulated\n");
     for s in signals {
@@ -223,61 +259,73 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
             s,
             &a.t_s,
             [y, b, e],
-            d.validation_segment_s[0],
+            a.diagnosis.validation_segment_s[0],
         )
         .map_err(|e| failed(&file, e))?;
-        figure(&mut md, &mut files, s, &file);
+        figure(md, files, s, &file);
     }
+    Ok(())
+}
+
+/// One residual order spectrum figure per spectrum of the analysis, the candidates'
+/// orders marked, written into `dir` and linked from the report.
+fn spectrum_section(
+    dir: &Path,
+    md: &mut String,
+    files: &mut Vec<String>,
+    a: &Analysis,
+) -> Result<(), CliError> {
     let _ = writeln!(md, "## Residual order spectra (nominal model)\n");
     let labels: Vec<String> = a
         .candidate_orders
         .iter()
         .map(|(k, name)| format!("{k}: {name}"))
         .collect();
+    let markers: Vec<Marker> = a
+        .candidate_orders
+        .iter()
+        .zip(&labels)
+        .map(|((k, _), l)| Marker {
+            x: *k as f64,
+            label: l,
+        })
+        .collect();
     for (s, spec) in &a.spectra {
         let file = format!("residual_spectrum_{s}.svg");
-        let points: Vec<(f64, f64)> = spec
-            .amplitude
-            .iter()
-            .enumerate()
-            .skip(1)
-            .take(200)
-            .map(|(k, v)| (k as f64, *v))
-            .collect();
-        let markers: Vec<Marker> = a
-            .candidate_orders
-            .iter()
-            .zip(&labels)
-            .map(|((k, _), l)| Marker {
-                x: *k as f64,
-                label: l,
-            })
-            .collect();
-        line_chart(
-            &dir.join(&file),
-            &format!(
-                "{s} residual against shaft angle ({} revolutions)",
-                spec.revolutions
-            ),
-            "order [cycles per revolution]",
-            "amplitude",
-            &[Series {
-                name: "residual",
-                points,
-            }],
-            &markers,
-            true,
-        )
-        .map_err(|e| failed(&file, e))?;
-        figure(
-            &mut md,
-            &mut files,
-            &format!("{s} residual spectrum"),
-            &file,
-        );
+        spectrum_figure(&dir.join(&file), s, spec, &markers).map_err(|e| failed(&file, e))?;
+        figure(md, files, &format!("{s} residual spectrum"), &file);
     }
-    crate::output::atomic::write(&dir.join("report.md"), md.as_bytes())
-        .map_err(|e| failed("report.md", e))?;
-    files.push("report.md".into());
-    Ok(files)
+    Ok(())
+}
+
+/// A residual's order spectrum over orders 1–200 with `markers` at the candidates' orders.
+fn spectrum_figure(
+    path: &Path,
+    signal: &str,
+    spec: &OrderSpectrum,
+    markers: &[Marker<'_>],
+) -> Result<(), String> {
+    let points: Vec<(f64, f64)> = spec
+        .amplitude
+        .iter()
+        .enumerate()
+        .skip(1)
+        .take(200)
+        .map(|(k, v)| (k as f64, *v))
+        .collect();
+    line_chart(
+        path,
+        &format!(
+            "{signal} residual against shaft angle ({} revolutions)",
+            spec.revolutions
+        ),
+        "order [cycles per revolution]",
+        "amplitude",
+        &[Series {
+            name: "residual",
+            points,
+        }],
+        markers,
+        true,
+    )
 }
