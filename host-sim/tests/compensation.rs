@@ -13,7 +13,7 @@ use common::{eha, s};
 use firmware::compensation::Compensation;
 use firmware::Config;
 use host_sim::compensate::flow::FlowParams;
-use host_sim::compensate::predict::{reduction_percent, without_and_with};
+use host_sim::compensate::predict::{reduction_percent, without_and_with_seed};
 use host_sim::compensate::study::{bench_learning, effects, with_effects, LEARNING_HOLD_S};
 use host_sim::compensate::{find, Feedforward, Found};
 use plant_model::pump::kinematic_ripple_ratio;
@@ -118,22 +118,34 @@ fn at_three_times_the_effects_the_feed_forward_cuts_the_pulsation() {
     holds_the_target(&rig, &plant, &ff);
 }
 
+/// Noise seeds of the evaluation runs: a peak-to-peak is one run's largest excursion, and
+/// the target must hold on each, not on one lucky draw.
+const EVALUATION_SEEDS: [u64; 3] = [1, 2, 3];
+
 /// Holding without the absorber (where the shaft's ripple is what reaches the oil) on
-/// `plant`, the controller configured from `rig`, without and with `ff`: at least 70 %
-/// less pulsation of the true pressure and of the shaft speed (its angle-locked part too).
+/// `plant`, the controller configured from `rig`, without and with `ff`, for each of
+/// [`EVALUATION_SEEDS`]: at least 70 % less pulsation of the true pressure and of the
+/// shaft speed (its angle-locked part too).
 fn holds_the_target(rig: &Rig, plant: &Rig, ff: &Feedforward) {
+    for seed in EVALUATION_SEEDS {
+        holds_the_target_with_seed(rig, plant, ff, seed);
+    }
+}
+
+fn holds_the_target_with_seed(rig: &Rig, plant: &Rig, ff: &Feedforward, seed: u64) {
     let bare = |r: &Rig| {
         let mut r = r.clone();
         r.absorber.enabled = false;
         r
     };
-    let (without, with) = without_and_with(&bare(plant), &bare(rig), &[ff]).expect("runs");
+    let (without, with) =
+        without_and_with_seed(&bare(plant), &bare(rig), &[ff], seed).expect("runs");
     let with = with[0];
     let cut = reduction_percent(without.speed_pp_rad_s, with.speed_pp_rad_s);
     let p_cut = reduction_percent(without.pressure_pp_pa, with.pressure_pp_pa);
     let locked = reduction_percent(without.speed_locked_pp_rad_s, with.speed_locked_pp_rad_s);
     eprintln!(
-        "speed pp {:.3} -> {:.3} rad/s ({cut:.0} %), angle-locked {:.3} -> {:.3} ({locked:.0} %); \
+        "seed {seed}: speed pp {:.3} -> {:.3} rad/s ({cut:.0} %), angle-locked {:.3} -> {:.3} ({locked:.0} %); \
          pressure pp {:.0} -> {:.0} Pa ({p_cut:.1} %)",
         without.speed_pp_rad_s,
         with.speed_pp_rad_s,

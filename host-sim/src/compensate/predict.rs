@@ -160,11 +160,12 @@ pub fn hold() -> Result<&'static Scenario, CliError> {
 }
 
 /// One holding run on `plant`, its controller configured from `controller`, with `ff`
-/// loaded (or none), for [`HOLD_S`].
+/// loaded (or none), for [`HOLD_S`], with the sensors' noise seed `seed`.
 pub fn holding(
     plant: &Rig,
     controller: &Rig,
     ff: Option<&Feedforward>,
+    seed: u64,
 ) -> Result<Pulsation, CliError> {
     let scenario = hold()?;
     let r = run(
@@ -174,7 +175,7 @@ pub fn holding(
         &RunOptions {
             duration_s: HOLD_S,
             log_rate_hz: LOG_RATE_HZ,
-            seed: 1,
+            seed,
             progress: false,
             metadata: Vec::new(),
             compensation: ff.cloned(),
@@ -184,18 +185,30 @@ pub fn holding(
     Ok(measure(&r, scenario))
 }
 
-/// Holding runs on `plant` without a feed-forward and with each of `tables`, in parallel.
+/// Holding runs on `plant` without a feed-forward and with each of `tables`, in parallel,
+/// with the sensors' noise seed 1.
 pub fn without_and_with(
     plant: &Rig,
     controller: &Rig,
     tables: &[&Feedforward],
+) -> Result<(Pulsation, Vec<Pulsation>), CliError> {
+    without_and_with_seed(plant, controller, tables, 1)
+}
+
+/// [`without_and_with`] with the sensors' noise seed `seed`: the peak-to-peak of a run is
+/// its largest excursion, so a figure near a target is read over several seeds.
+pub fn without_and_with_seed(
+    plant: &Rig,
+    controller: &Rig,
+    tables: &[&Feedforward],
+    seed: u64,
 ) -> Result<(Pulsation, Vec<Pulsation>), CliError> {
     let jobs: Vec<Option<&Feedforward>> = std::iter::once(None)
         .chain(tables.iter().map(|t| Some(*t)))
         .collect();
     let mut out = jobs
         .par_iter()
-        .map(|t| holding(plant, controller, *t))
+        .map(|t| holding(plant, controller, *t, seed))
         .collect::<Result<Vec<_>, _>>()?
         .into_iter();
     let without = out

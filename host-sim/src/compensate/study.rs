@@ -316,7 +316,7 @@ pub fn rows_for(rig: &Rig, level: f64) -> Result<Vec<Row>, CliError> {
         ];
         let results = cases
             .par_iter()
-            .map(|(_, p, table)| predict::holding(p, &controller, *table))
+            .map(|(_, p, table)| predict::holding(p, &controller, *table, 1))
             .collect::<Result<Vec<_>, _>>()?;
         let mut reference = results[0];
         for ((label, _, table), p) in cases.iter().zip(results) {
