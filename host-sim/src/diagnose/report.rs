@@ -44,6 +44,10 @@ fn trace_figure(
     [y, b, e]: [&Vec<f64>; 3],
     t_val: f64,
 ) -> Result<(), String> {
+    // Pressures read in MPa: a 5 MPa axis in pascals is seven digits a tick.
+    let (scale, unit) = display_unit(unit_of(signal));
+    let shown = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x * scale).collect() };
+    let (y, b, e) = (&shown(y), &shown(b), &shown(e));
     let residual = |m: &[f64]| -> Vec<f64> { y.iter().zip(m).map(|(y, m)| y - m).collect() };
     let traces = [
         Series {
@@ -73,8 +77,8 @@ fn trace_figure(
         x: t_val,
         label: "validation →",
     }];
-    let signal_label = format!("{signal} [{}]", unit_of(signal));
-    let residual_label = format!("residual [{}]", unit_of(signal));
+    let signal_label = format!("{signal} [{unit}]");
+    let residual_label = format!("residual [{unit}]");
     stacked_chart(
         path,
         &format!("{signal}: measured, nominal model, extended model; the residuals beneath"),
@@ -88,6 +92,14 @@ fn trace_figure(
             Panel::new(&residual_label, &residuals).weight(2).robust(),
         ],
     )
+}
+
+/// The scale and unit a figure shows a signal of `unit` in: pascals as megapascals.
+fn display_unit(unit: &'static str) -> (f64, &'static str) {
+    match unit {
+        "Pa" => (1e-6, "MPa"),
+        u => (1.0, u),
+    }
 }
 
 /// The unit a bench-log column's name ends in.
