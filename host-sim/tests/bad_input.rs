@@ -54,18 +54,7 @@ fn hold_log(dir: &Path) -> PathBuf {
 
 /// A pressure-hold log of `seconds` written to `dir/name`.
 fn hold_log_of(dir: &Path, name: &str, seconds: &str) -> PathBuf {
-    let log = dir.join(name);
-    let o = eha(&[
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
-        seconds,
-        "--out",
-        s(&log),
-    ]);
-    assert_eq!(status(&o), 0, "{}", stderr(&o));
-    log
+    common::simulated_hold(dir, name, seconds, &[])
 }
 
 /// `log` with `column` rewritten row by row (`row index, old text → new text`).

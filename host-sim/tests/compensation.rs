@@ -24,20 +24,7 @@ use std::fs;
 /// `eha simulate`'s pressure holding of `seconds` written to `dir/hold.csv`, with the
 /// further arguments `extra`.
 fn hold_log(dir: &std::path::Path, seconds: &str, extra: &[&str]) -> std::path::PathBuf {
-    let log = dir.join("hold.csv");
-    let mut args = vec![
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
-        seconds,
-        "--out",
-        s(&log),
-    ];
-    args.extend_from_slice(extra);
-    let o = eha(&args);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    log
+    common::simulated_hold(dir, "hold.csv", seconds, extra)
 }
 
 /// `eha compensate LOG --out TABLE` with the further arguments `extra`: its standard

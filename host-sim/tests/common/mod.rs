@@ -26,3 +26,22 @@ pub fn scratch(prefix: &str, name: &str) -> PathBuf {
 pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// `eha simulate`'s pressure holding of `seconds` written to `dir/name`, with the further
+/// arguments `extra` (it must succeed).
+pub fn simulated_hold(dir: &Path, name: &str, seconds: &str, extra: &[&str]) -> PathBuf {
+    let log = dir.join(name);
+    let mut args = vec![
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        seconds,
+        "--out",
+        s(&log),
+    ];
+    args.extend_from_slice(extra);
+    let o = eha(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    log
+}
