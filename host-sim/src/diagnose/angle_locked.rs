@@ -17,6 +17,7 @@
 //! K_t and J could leave of the measured current and angle lines ([`TORQUE_TOLERANCE`]):
 //! a voltage disturbance moving current and angle together cannot pass for a torque.
 
+use crate::diagnose::back_emf::back_emf_lines;
 use crate::diagnose::lines::{OrderLines, WindowLines};
 use plant_model::motor::Motor;
 use plant_model::Rig;
@@ -112,14 +113,89 @@ pub struct LineFit {
     /// Complex amplitude per unit regressor of the unexplained torque line (coherent), or
     /// its magnitude on the real axis (incoherent). [N·m or 1]
     pub amplitude: Complex64,
+    /// Information about `amplitude` (Σ |x|²/σ² over its lines). [1/amplitude²]
+    pub information: f64,
+    /// Flux harmonics, phase-locked: the d-axis back-EMF's amplitude per ψ_f·ω_e, which the
+    /// 5th/7th split leaves free ([`super::back_emf`]); zero otherwise. [1]
+    pub back_emf_d: Complex64,
     /// Generalised likelihood ratio (twice the log-likelihood gain) on the fitted windows.
     pub lambda: f64,
-    /// Degrees of freedom of `lambda` under no line (2 coherent, 2 per window otherwise).
+    /// Degrees of freedom of `lambda` under no line (2 per complex amplitude coherent, 2
+    /// per window otherwise).
     pub dof: usize,
     /// Windows used.
     pub windows: usize,
     /// Whether the phases were combined (the angle was logged).
     pub coherent: bool,
+}
+
+/// One line an effect explains in one window: measured, what one unit of the amplitude
+/// makes of it, its noise variance per real component, and whether it follows the flux
+/// harmonics' free d-axis amplitude instead of the effect's own.
+#[derive(Clone, Copy, Debug)]
+struct Observation {
+    line: Complex64,
+    regressor: Complex64,
+    var: f64,
+    free_d: bool,
+}
+
+/// The lines `effect` explains in window `w`: its torque line, and, for flux harmonics
+/// with the angle logged, the back-EMF's q- and d-current lines.
+fn observations(
+    effect: LineEffect,
+    w: &WindowLines,
+    rig: &Rig,
+    shaft: ShaftConstants,
+    candidates: &[u32],
+    coherent: bool,
+) -> Vec<Observation> {
+    let ShaftConstants { kt, j, d_per_rad } = shaft;
+    let Some(o) = w.at(effect.order(rig)) else {
+        return Vec::new();
+    };
+    let ripple_per_ratio = match effect {
+        LineEffect::PistonRipple(z) => super::mechanical::ripple_fundamental_per_ratio(rig, z),
+        _ => 0.0,
+    };
+    let mut out = Vec::new();
+    let var = torque_variance(w, o, candidates, kt, j);
+    let x = regressor(effect, w, kt, ripple_per_ratio, d_per_rad);
+    if var.is_finite() && x.abs() > 0.0 {
+        out.push(Observation {
+            line: o.torque,
+            regressor: Complex64::new(x, 0.0),
+            var,
+            free_d: false,
+        });
+    }
+    if effect == LineEffect::FluxHarmonics && coherent {
+        if let Some([q, d]) = back_emf_lines(w, o, rig, candidates) {
+            for (l, free_d) in [(q, false), (d, true)] {
+                out.push(Observation {
+                    line: l.line,
+                    regressor: l.regressor,
+                    var: l.var,
+                    free_d,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The weighted least-squares amplitude of `obs` (those with `free_d` as given) and its
+/// information; `None` without information.
+fn amplitude_of(obs: &[Observation], free_d: bool) -> Option<(Complex64, f64)> {
+    let group = obs.iter().filter(|o| o.free_d == free_d);
+    let info: f64 = group.clone().map(|o| o.regressor.norm_sqr() / o.var).sum();
+    (info > 0.0).then(|| {
+        let a = group
+            .map(|o| o.regressor.conj() * o.line / o.var)
+            .sum::<Complex64>()
+            / info;
+        (a, info)
+    })
 }
 
 /// Fits `effect` to the windows `lines` (already restricted to the segment wanted).
@@ -131,49 +207,47 @@ pub fn fit_line(
     candidates: &[u32],
     coherent: bool,
 ) -> Option<LineFit> {
-    let ShaftConstants { kt, j, d_per_rad } = shaft;
-    let order = effect.order(rig);
-    let ripple_per_ratio = match effect {
-        LineEffect::PistonRipple(z) => super::mechanical::ripple_fundamental_per_ratio(rig, z),
-        _ => 0.0,
-    };
-    let mut data = Vec::new();
-    for w in lines {
-        let Some(o) = w.at(order) else { continue };
-        let var = torque_variance(w, o, candidates, kt, j);
-        let x = regressor(effect, w, kt, ripple_per_ratio, d_per_rad);
-        if var.is_finite() && x.abs() > 0.0 {
-            data.push((o.torque, x, var));
-        }
-    }
-    if data.is_empty() {
-        return None;
-    }
-    let info: f64 = data.iter().map(|(_, x, v)| x * x / v).sum();
-    let (amplitude, lambda, dof) = if coherent {
-        let a = data.iter().map(|(t, x, v)| t * (x / v)).sum::<Complex64>() / info;
-        (a, a.norm_sqr() * info, 2)
+    let per_window: Vec<Vec<Observation>> = lines
+        .iter()
+        .map(|w| observations(effect, w, rig, shaft, candidates, coherent))
+        .filter(|o| !o.is_empty())
+        .collect();
+    let obs: Vec<Observation> = per_window.iter().flatten().copied().collect();
+    let (amplitude, information) = amplitude_of(&obs, false)?;
+    let (amplitude, back_emf_d, lambda, dof) = if coherent {
+        let (d, d_info) = amplitude_of(&obs, true).unwrap_or_default();
+        let lambda = amplitude.norm_sqr() * information + d.norm_sqr() * d_info;
+        (amplitude, d, lambda, if d_info > 0.0 { 4 } else { 2 })
     } else {
-        let a = data
+        // Only magnitudes: the torque lines' (the only observations without the angle).
+        let a = obs
             .iter()
-            .map(|(t, x, v)| t.norm() * x.abs() / v)
+            .map(|o| o.line.norm() * o.regressor.norm() / o.var)
             .sum::<f64>()
-            / info;
-        let l = data.iter().map(|(t, _, v)| t.norm_sqr() / v).sum::<f64>();
-        (Complex64::new(a, 0.0), l, 2 * data.len())
+            / information;
+        let l = obs.iter().map(|o| o.line.norm_sqr() / o.var).sum::<f64>();
+        (
+            Complex64::new(a, 0.0),
+            Complex64::default(),
+            l,
+            2 * obs.len(),
+        )
     };
     Some(LineFit {
         effect,
         amplitude,
+        information,
+        back_emf_d,
         lambda,
         dof,
-        windows: data.len(),
+        windows: per_window.len(),
         coherent,
     })
 }
 
 /// How much of the line power `fit` predicts in the windows `lines` (the validation
-/// segment's): Σ (|T|² − |T − A·x|²)/σ², positive when the fitted line is there. [1]
+/// segment's): Σ (|y|² − |y − ŷ|²)/σ² over its lines, positive when the fitted line is
+/// there. [1]
 pub fn line_gain(
     fit: &LineFit,
     lines: &[&WindowLines],
@@ -181,29 +255,22 @@ pub fn line_gain(
     shaft: ShaftConstants,
     candidates: &[u32],
 ) -> Option<f64> {
-    let ShaftConstants { kt, j, d_per_rad } = shaft;
-    let order = fit.effect.order(rig);
-    let ripple_per_ratio = match fit.effect {
-        LineEffect::PistonRipple(z) => super::mechanical::ripple_fundamental_per_ratio(rig, z),
-        _ => 0.0,
-    };
     let mut gain = 0.0;
     let mut n = 0;
     for w in lines {
-        let Some(o) = w.at(order) else { continue };
-        let var = torque_variance(w, o, candidates, kt, j);
-        if !var.is_finite() {
-            continue;
+        for o in observations(fit.effect, w, rig, shaft, candidates, fit.coherent) {
+            let predicted = if !fit.coherent {
+                // Only the magnitude is known: the best phase, i.e. the magnitudes compared.
+                o.line
+                    * (fit.amplitude.re * o.regressor.norm() / o.line.norm().max(f64::MIN_POSITIVE))
+            } else if o.free_d {
+                fit.back_emf_d * o.regressor
+            } else {
+                fit.amplitude * o.regressor
+            };
+            gain += (o.line.norm_sqr() - (o.line - predicted).norm_sqr()) / o.var;
+            n += 1;
         }
-        let x = regressor(fit.effect, w, kt, ripple_per_ratio, d_per_rad);
-        let predicted = if fit.coherent {
-            fit.amplitude * x
-        } else {
-            // Only the magnitude is known: the best phase, i.e. the magnitudes compared.
-            o.torque * (fit.amplitude.re * x.abs() / o.torque.norm().max(f64::MIN_POSITIVE))
-        };
-        gain += (o.torque.norm_sqr() - (o.torque - predicted).norm_sqr()) / var;
-        n += 1;
     }
     (n > 0).then_some(gain)
 }

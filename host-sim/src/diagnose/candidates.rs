@@ -11,7 +11,7 @@
 //! | `cylinder_friction` | cylinder relation, Coulomb force released | 0–3× the rig's |
 //! | `dead_time` | electrical relation (voltages logged), else the d/q current lines at 6·p_n | 0–0.1 µs |
 //! | `cogging_torque` | torque line at the slot order | 0.01 N·m |
-//! | `flux_harmonics` | torque line at 6·p_n ∝ mean torque | 0.5 % |
+//! | `flux_harmonics` | torque line at 6·p_n ∝ mean torque, and (angle logged) its back-EMF's current lines | 0.5 % |
 //! | `piston_ripple` | torque line at 2z ∝ Δp | the kinematic ripple |
 //! | `current_sensor_offset` | torque line at p_n (the current that did not flow) | 0.03 A |
 //!
@@ -251,11 +251,7 @@ pub fn test_lines(
 
 fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) -> Tested {
     // Standard error of the amplitude: one over the root of the information.
-    let info = if f.amplitude.norm() > 0.0 {
-        f.lambda / f.amplitude.norm_sqr()
-    } else {
-        0.0
-    };
+    let info = f.information;
     let se = if info > 0.0 {
         1.0 / info.sqrt()
     } else {
@@ -303,12 +299,20 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
             ),
         ),
     };
-    let evidence =
-        format!(
-        "unexplained torque line at order {order} over {} steady window(s){}: {what}; Λ = {:.1} \
-         ({} degrees of freedom)",
+    let with_emf = if f.dof == 4 {
+        " with its back-EMF's d- and q-current lines"
+    } else {
+        ""
+    };
+    let evidence = format!(
+        "unexplained torque line at order {order}{with_emf} over {} steady window(s){}: {what}; \
+         Λ = {:.1} ({} degrees of freedom)",
         f.windows,
-        if f.coherent { ", phase-locked to the logged angle" } else { "" },
+        if f.coherent {
+            ", phase-locked to the logged angle"
+        } else {
+            ""
+        },
         f.lambda,
         f.dof
     );

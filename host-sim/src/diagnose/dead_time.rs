@@ -16,9 +16,11 @@
 //! instead ([`super::angle_locked`]).
 //!
 //! The fit: per steady window the model's line magnitudes |I_d|, |I_q| per unit dead time at
-//! the window's current and speed, the measured ones by weighted least squares, the fade
-//! band searched over a grid (it is not in the rig contract).
+//! the window's current and speed, the measured ones by weighted least squares (each line's
+//! variance its noise floor plus [`LOOP_TOLERANCE`] of it: the loops are Table 1's, a
+//! bench's differ), the fade band searched over a grid (it is not in the rig contract).
 
+use crate::diagnose::back_emf::LOOP_TOLERANCE;
 use crate::diagnose::lines::WindowLines;
 use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use plant_model::Rig;
@@ -88,6 +90,9 @@ struct Obs {
     measured: [f64; 2],
     model: [f64; 2],
     var: [f64; 2],
+    /// The noise floors alone, which weigh the scale's estimate (weights from the measured
+    /// lines would bias it). [A²]
+    floor: [f64; 2],
 }
 
 fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]) -> Vec<Obs> {
@@ -97,8 +102,11 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
         .iter()
         .filter_map(|w| {
             let o = w.at(order)?;
-            let var_d = w.floor(order, candidates, |x| x.id);
-            let var_q = w.floor(order, candidates, |x| x.iq);
+            let floor_d = w.floor(order, candidates, |x| x.id);
+            let floor_q = w.floor(order, candidates, |x| x.iq);
+            // The loops' model is Table 1's: its uncertainty on top of the noise floor.
+            let tol = |z: Complex64| 0.5 * (LOOP_TOLERANCE * z.norm()).powi(2);
+            let (var_d, var_q) = (floor_d + tol(o.id), floor_q + tol(o.iq));
             if !(var_d.is_finite() && var_q.is_finite()) {
                 return None;
             }
@@ -109,6 +117,7 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
                 measured: [o.id.norm(), o.iq.norm()],
                 model: [(hd * ed).norm(), (hq * eq).norm()],
                 var: [var_d, var_q],
+                floor: [floor_d, floor_q],
             })
         })
         .collect()
@@ -116,7 +125,7 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
 
 /// Fits the dead time to the d and q current lines at order 6·p_n of `lines`.
 pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> Option<DeadTimeFit> {
-    let mut best: Option<DeadTimeFit> = None;
+    let mut best: Option<(f64, DeadTimeFit)> = None;
     let max_scale =
         MAX_DEAD_TIME_PERIODS / rig.inverter.pwm_frequency_hz.max(1.0) / REFERENCE_DEAD_TIME_S;
     for band in BANDS_A {
@@ -124,7 +133,7 @@ pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> O
         if obs.is_empty() {
             return None;
         }
-        let Some((scale, lambda)) = solve(&obs, max_scale) else {
+        let Some((scale, by_floor, lambda)) = solve(&obs, max_scale) else {
             continue;
         };
         let fit = DeadTimeFit {
@@ -133,23 +142,23 @@ pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> O
             lambda,
             windows: obs.len(),
         };
-        if best.as_ref().is_none_or(|b| fit.lambda > b.lambda) {
-            best = Some(fit);
+        if best.as_ref().is_none_or(|(b, _)| by_floor > *b) {
+            best = Some((by_floor, fit));
         }
     }
-    best
+    best.map(|(_, fit)| fit)
 }
 
-/// The weighted least-squares scale of the model lines onto the measured ones and the line
-/// power it explains; `None` when no model line is there or the scale would pass
-/// `max_scale`.
-fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64)> {
-    let (mut num, mut den, mut power) = (0.0, 0.0, 0.0);
+/// The weighted least-squares scale of the model lines onto the measured ones, and the
+/// line power it explains weighed by the noise floors alone (which choose the fade band)
+/// and with the loops' uncertainty (the reported Λ); `None` when no model line is there or
+/// the scale would pass `max_scale`.
+fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64, f64)> {
+    let (mut num, mut den) = (0.0, 0.0);
     for o in obs {
         for a in 0..2 {
-            num += o.measured[a] * o.model[a] / o.var[a];
-            den += o.model[a] * o.model[a] / o.var[a];
-            power += o.measured[a] * o.measured[a] / o.var[a];
+            num += o.measured[a] * o.model[a] / o.floor[a];
+            den += o.model[a] * o.model[a] / o.floor[a];
         }
     }
     if den <= 0.0 {
@@ -159,11 +168,22 @@ fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64)> {
     if scale > max_scale {
         return None;
     }
-    let resid: f64 = obs
-        .iter()
-        .flat_map(|o| (0..2).map(move |a| (o.measured[a] - scale * o.model[a]).powi(2) / o.var[a]))
-        .sum();
-    Some((scale, (power - resid).max(0.0)))
+    let explained = |weight: fn(&Obs, usize) -> f64| -> f64 {
+        obs.iter()
+            .flat_map(|o| {
+                (0..2).map(move |a| {
+                    (o.measured[a].powi(2) - (o.measured[a] - scale * o.model[a]).powi(2))
+                        / weight(o, a)
+                })
+            })
+            .sum::<f64>()
+            .max(0.0)
+    };
+    Some((
+        scale,
+        explained(|o, a| o.floor[a]),
+        explained(|o, a| o.var[a]),
+    ))
 }
 
 /// The line power `fit` explains in the windows `lines`. [1]
@@ -214,14 +234,16 @@ mod tests {
                 measured: [3.0, 3.0],
                 model: [1.0, 1.0],
                 var: [1.0, 1.0],
+                floor: [1.0, 1.0],
             },
             Obs {
                 measured: [6.0, 6.0],
                 model: [2.0, 2.0],
                 var: [1.0, 1.0],
+                floor: [1.0, 1.0],
             },
         ];
-        let (scale, lambda) = solve(&obs, 10.0).unwrap();
+        let (scale, lambda, _) = solve(&obs, 10.0).unwrap();
         assert!((scale - 3.0).abs() < 1e-12 && (lambda - 90.0).abs() < 1e-9);
         // The same lines where the model has almost none: the scale would be 3·10⁶.
         let faint = obs.map(|o| Obs {

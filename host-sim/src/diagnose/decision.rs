@@ -18,10 +18,9 @@
 //!    −[`VALIDATION_TOLERANCE`]): an effect the validation segment excites must improve it
 //!    or be refuted; one it does not excite (a bulk modulus seen only in a fill below the
 //!    precharge) cannot be confirmed there and stands on its identification evidence.
-//! 4. **No structural veto.** A dead time read from the current lines is not named while
-//!    the same order carries an unexplained torque (flux harmonics move the d current
-//!    through their back-EMF too; a dead time moves current and shaft together and leaves
-//!    no torque).
+//! 4. **No structural veto.** A dead time read from the current lines and the flux
+//!    harmonics share the lines at order 6·p_n: only the one that explains them better is
+//!    named ([`apply_vetoes`]).
 //!
 //! Among the effects that qualify the one with the largest Λ is named; `none` otherwise.
 
@@ -63,24 +62,45 @@ pub fn why_not(t: &Tested) -> Option<String> {
     t.veto.clone()
 }
 
-/// Applies the structural vetoes across `tested`.
+/// Applies the structural vetoes across `tested`: the dead time read from the current
+/// lines and the flux harmonics share the lines at order 6·p_n, and only one of them is
+/// named.
+///
+/// With the angle logged both are fitted to those lines (the flux harmonics with their
+/// back-EMF, [`crate::diagnose::back_emf`]), and the one standing further above its own
+/// significance threshold (Λ less the χ² quantile of its degrees of freedom: the flux
+/// harmonics' free d-axis amplitude costs them two more) explains them; the other is
+/// vetoed. Without the angle the flux harmonics have only the torque line's magnitudes, and
+/// a significant one vetoes the dead time (a dead time moves current and shaft together
+/// and leaves no torque).
 pub fn apply_vetoes(tested: &mut [Tested]) {
-    let flux_torque = tested
+    use crate::diagnose::candidates::Extension;
+    let flux = tested.iter().position(|t| t.effect == "flux_harmonics");
+    let dead = tested
         .iter()
-        .any(|t| t.effect == "flux_harmonics" && t.lambda > threshold(t.dof));
-    for t in tested.iter_mut() {
-        if t.effect == "dead_time"
-            && flux_torque
-            && matches!(
-                t.extension,
-                crate::diagnose::candidates::Extension::CurrentLines(_)
-            )
-        {
-            t.veto = Some(
-                "the torque balance leaves a line at the same order: a torque ripple, not a voltage error"
-                    .into(),
-            );
-        }
+        .position(|t| t.effect == "dead_time" && matches!(t.extension, Extension::CurrentLines(_)));
+    let (Some(f), Some(d)) = (flux, dead) else {
+        return;
+    };
+    let margin = |t: &Tested| t.lambda - threshold(t.dof);
+    let (mf, md) = (margin(&tested[f]), margin(&tested[d]));
+    let joint =
+        matches!(&tested[f].extension, Extension::TorqueLine(l) if l.coherent && l.dof == 4);
+    if joint && mf > 0.0 && mf >= md {
+        tested[d].veto = Some(format!(
+            "the flux harmonics explain the current lines at 6·p_n better (Λ − threshold \
+             {mf:.1} against {md:.1})"
+        ));
+    } else if joint && md > 0.0 && md > mf {
+        tested[f].veto = Some(format!(
+            "an inverter dead time explains the current lines at 6·p_n better (Λ − threshold \
+             {md:.1} against {mf:.1})"
+        ));
+    } else if !joint && mf > 0.0 {
+        tested[d].veto = Some(
+            "the torque balance leaves a line at the same order: a torque ripple, not a voltage error"
+                .into(),
+        );
     }
 }
 

@@ -22,6 +22,7 @@
 
 pub mod analysis;
 pub mod angle_locked;
+pub mod back_emf;
 pub mod calibration;
 pub mod candidates;
 pub mod command;
