@@ -42,7 +42,10 @@ pub const COULOMB_FADE_RAD_S: f64 = 0.5;
 pub enum LineScale {
     /// Nothing: a torque in N·m (cogging, a current offset's image through K_t).
     Constant,
-    /// The electromagnetic torque K_t·i_q (flux harmonics, eq. 19).
+    /// The electromagnetic torque K_t·i_q (flux harmonics, eq. 19) at the q current's
+    /// moving mean: the amplitude is fitted per unit of the steady windows' mean torque,
+    /// and the ripple's product with the current's own line at its order (a mean torque
+    /// the calibrated friction already holds) is left out.
     Electromagnetic,
     /// The pump's pressure difference times this factor (its torque ripple, eq. 20). [m³/rad]
     PressureDifference(f64),
@@ -247,13 +250,14 @@ impl Mechanics {
         out: &mut [f64],
     ) {
         let j = self.params.inertia_kg_m2;
+        let slow = mean_current(&log.iq_a, facts.period_s);
         for k in rows {
             let w = motion.speed_rad_s[k];
             let need = self.load_torque(log, facts, k, w) + j * motion.accel_rad_s2[k];
             let (slope, rest) = self.torque_terms(log, facts, k);
             let slope = if slope.abs() > 1e-9 { slope } else { 1e-9 };
-            let t_em = slope * log.iq_a[k] + rest;
-            out[k] = (need - rest + self.line_torque(log, facts, k, t_em)) / slope;
+            let t_mean = slope * slow[k] + rest;
+            out[k] = (need - rest + self.line_torque(log, facts, k, t_mean)) / slope;
         }
     }
 
@@ -269,6 +273,7 @@ impl Mechanics {
     ) {
         let t = &log.t_s;
         let j = self.params.inertia_kg_m2.max(1e-12);
+        let slow = mean_current(&log.iq_a, facts.period_s);
         for win in windows {
             let mut w = motion.speed_rad_s[win.start];
             out[win.start] = w;
@@ -276,7 +281,7 @@ impl Mechanics {
                 let (slope, rest) = self.torque_terms(log, facts, k);
                 let t_em = slope * log.iq_a[k] + rest;
                 let drive = t_em
-                    - self.line_torque(log, facts, k, t_em)
+                    - self.line_torque(log, facts, k, slope * slow[k] + rest)
                     - self.load_torque(log, facts, k, w);
                 w += (t[k + 1] - t[k]) * drive / j;
                 out[k + 1] = w;
@@ -284,6 +289,27 @@ impl Mechanics {
         }
     }
 }
+
+/// The q current's moving mean over ±[`MEAN_CURRENT_HALF_WIDTH_S`] of rows `period` [s]
+/// apart. [A]
+fn mean_current(iq: &[f64], period: f64) -> Vec<f64> {
+    let half = (MEAN_CURRENT_HALF_WIDTH_S / period.max(f64::MIN_POSITIVE)).round() as usize;
+    let mut prefix = vec![0.0; iq.len() + 1];
+    for (k, i) in iq.iter().enumerate() {
+        prefix[k + 1] = prefix[k] + i;
+    }
+    (0..iq.len())
+        .map(|k| {
+            let lo = k.saturating_sub(half);
+            let hi = (k + half + 1).min(iq.len());
+            (prefix[hi] - prefix[lo]) / (hi - lo) as f64
+        })
+        .collect()
+}
+
+/// Half width of the q current's moving mean that scales the flux harmonics' torque line:
+/// several periods of the 6·p_n line at the lowest speeds a steady window is read at. [s]
+pub const MEAN_CURRENT_HALF_WIDTH_S: f64 = 0.025;
 
 /// Mean over a revolution of the pump's torque ripple at its fundamental order per unit
 /// peak-to-peak ratio: the amplitude of (s(θ) − 1)'s line at 2z (odd z) or z for a ripple
