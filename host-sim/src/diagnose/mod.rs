@@ -42,6 +42,7 @@ pub mod report;
 pub mod result;
 pub mod signatures;
 pub mod spectrum;
+pub mod stick;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 
