@@ -64,7 +64,7 @@ pub enum Release {
     ShaftFriction,
     /// Inverter dead time (electrical relation).
     DeadTime,
-    /// Cylinder Coulomb friction.
+    /// Cylinder Coulomb friction and, with it, the breakaway's excess over it.
     CylinderFriction,
 }
 
