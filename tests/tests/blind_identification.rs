@@ -61,9 +61,7 @@ const MIN_FIT_GAIN: f64 = 0.0;
 const DISTINGUISHABLE_GAIN: f64 = 10.0;
 /// Seeds the diagnosis may miss. Not zero: with structure drawn, the known misses are a
 /// flux harmonic at light load without voltage columns (its current lines read as a dead
-/// time, or as nothing) and the breakaway force of the cylinder (reported equal to the
-/// Coulomb force);
-/// `docs/diagnosis.md` lists them. A regression beyond this count
+/// time, or as nothing); `docs/diagnosis.md` lists them. A regression beyond this count
 /// fails. [1]
 const MAX_MISSES: usize = 3;
 /// False alarms allowed in the false-alarm set. [1]
