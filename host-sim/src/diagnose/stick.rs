@@ -172,30 +172,18 @@ pub fn quantisation_step(x: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Uniform deviates from a fixed linear congruential generator, mapped to a Gaussian
-    /// by the sum of twelve (variance 1).
-    fn gaussian(seed: &mut u64) -> f64 {
-        (0..12)
-            .map(|_| {
-                *seed = seed
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                (*seed >> 11) as f64 / (1u64 << 53) as f64
-            })
-            .sum::<f64>()
-            - 6.0
-    }
+    use crate::diagnose::test_noise::gaussian;
 
     #[test]
     fn the_fourth_difference_median_reads_white_noise_under_a_swinging_payload() {
         // A 40 Hz swing of 0.2 mm (a second difference of ~13 µm per row at 1 kHz) with
         // 1 µm of white noise: the noise is read within the median's sampling error.
-        let mut seed = 7;
-        let x: Vec<f64> = (0..20_000)
-            .map(|k| {
+        let x: Vec<f64> = gaussian(20_000, 7)
+            .iter()
+            .enumerate()
+            .map(|(k, n)| {
                 let t = k as f64 * 1e-3;
-                2e-4 * (std::f64::consts::TAU * 40.0 * t).sin() + 1e-6 * gaussian(&mut seed)
+                2e-4 * (std::f64::consts::TAU * 40.0 * t).sin() + 1e-6 * n
             })
             .collect();
         let s = position_noise(&x);
