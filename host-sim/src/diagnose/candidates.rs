@@ -8,7 +8,7 @@
 //! | `accumulator_precharge` | hydraulic relation, precharge released | p_0 ±5 % |
 //! | `pressure_sensor_lag` | hydraulic relation, lag released | 0–2.5 ms |
 //! | `shaft_friction` | mechanical relation, Coulomb torque released | 0–0.02 N·m |
-//! | `cylinder_friction` | cylinder relation, Coulomb force and breakaway excess released together | each 0–3× the rig's |
+//! | `cylinder_friction` | cylinder relation, Coulomb and breakaway force released together (the breakaway where the piston rests) | each 0–3× the rig's |
 //! | `dead_time` | electrical relation (voltages logged), else the d/q current lines at 6·p_n | 0–0.1 µs |
 //! | `cogging_torque` | torque line at the slot order | 0.01 N·m |
 //! | `flux_harmonics` | torque line at 6·p_n ∝ mean torque | 0.5 % |
@@ -89,8 +89,8 @@ pub struct Tested {
     pub extension: Extension,
 }
 
-/// The catalogue's effect a release tests, its parameters' indices (the first the main
-/// one) and the extension at the released values `v`.
+/// The catalogue's effect a release tests, the indices of the parameters it may release
+/// (the first the main one) and the extension at the released values `v`.
 fn released_effect(release: Release, v: &[f64]) -> (&'static [usize], &'static str, Extension) {
     let v = v.to_vec();
     match release {
@@ -128,7 +128,15 @@ pub fn from_release<R: Relation>(
     let v = &test.fitted.values;
     let specs = relation.specs(test.release);
     let base_specs = relation.specs(Release::Nothing);
-    let (indices, effect, extension) = released_effect(test.release, v);
+    let (all, effect, extension) = released_effect(test.release, v);
+    // The main parameter, and the others the relation released on this log (the
+    // cylinder's breakaway only where the piston is seen resting).
+    let indices: Vec<usize> = all
+        .iter()
+        .enumerate()
+        .filter(|(n, i)| *n == 0 || specs[**i].band.is_none())
+        .map(|(_, i)| *i)
+        .collect();
     // Outside its band: the released estimate lies beyond it. That it lies there
     // significantly is the likelihood ratio itself: the baseline is the best fit with the
     // parameter held within the band (at its edge, when the data pull outwards), so Λ is
@@ -156,8 +164,7 @@ pub fn from_release<R: Relation>(
             // Coulomb level to it.
             let c = &rig.cylinder;
             let coulomb = (value - c.coulomb_friction_n).max(0.0);
-            let breakaway = value + v[cylinder::ix::BREAKAWAY];
-            let static_n = (breakaway - c.static_friction_n).max(coulomb);
+            let static_n = (cylinder::breakaway_level(v) - c.static_friction_n).max(coulomb);
             vec![("coulomb_n", coulomb), ("static_n", static_n)]
         }
         Release::Nothing => Vec::new(),
@@ -174,7 +181,7 @@ pub fn from_release<R: Relation>(
         outside_band,
         validation_gain,
         veto: None,
-        evidence: release_evidence(test, indices, &specs, &base_specs),
+        evidence: release_evidence(test, &indices, &specs, &base_specs),
         extension,
     }
 }

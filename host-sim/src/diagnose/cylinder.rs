@@ -29,14 +29,20 @@
 //!   noise): one more residual per breakaway. Without it the resting rows would leave
 //!   every F_s above the largest held force equally good.
 //!
-//! The breakaway is searched as its excess F_s − F_c ≥ 0 over the Coulomb force (the plant
-//! raises a breakaway below the Coulomb level to it): both levels move together with the
-//! seal's wear, so a released Coulomb force carries the breakaway along, and the excess
-//! keeps a slope for the optimiser wherever the Coulomb force goes (an absolute F_s below
-//! F_c would be flat). Its tolerance band in the calibrated baseline is 0 to
-//! [`BREAKAWAY_BAND`] times the rig file's F_s − F_c (at least 10 N): with the Coulomb force
-//! at the top of its own band the breakaway stays within 3× the rig file's static level.
-//! `cylinder_friction` releases both together ([`super::candidates`]).
+//! The breakaway F_s is a parameter of its own beside the Coulomb force F_c, and the
+//! model uses max(F_s, F_c) as the plant does (it raises a breakaway below the Coulomb level
+//! to it): the resting rows and the breakaways fix F_s, the sliding rows F_c, each without
+//! dragging the other (searched as an excess over F_c, the breakaway was pushed to its
+//! floor whenever the search passed through too high a Coulomb force, and the bounds'
+//! sine transform held it there). It is searched in logarithm, its tolerance band in the calibrated
+//! baseline up to [`BREAKAWAY_BAND`] times the rig file's static level.
+//! `cylinder_friction` releases it with the Coulomb force ([`super::candidates`]) when the
+//! piston rests somewhere in the identification segment
+//! ([`CylinderRelation::sees_rest`]), starting from the level the log shows
+//! ([`CylinderRelation::breakaway_seen`]): a log that never shows the piston resting says
+//! nothing of the breakaway, which then stays in its band. Rests without a breakaway bound
+//! it from below only: the breakaway found is the largest force the piston was seen to
+//! hold.
 
 use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::calibration::{Relation, Release};
@@ -62,7 +68,7 @@ pub mod ix {
     pub const VISCOUS: usize = 1;
     /// Coulomb friction.
     pub const COULOMB: usize = 2;
-    /// Breakaway (static) friction's excess over the Coulomb friction.
+    /// Breakaway (static) friction (the Coulomb friction where below it).
     pub const BREAKAWAY: usize = 3;
     /// Low-side pressure, when it is not logged.
     pub const LOW_SIDE: usize = 4;
@@ -78,9 +84,13 @@ pub const LOW_SIDE_BAND_PA: (f64, f64) = (0.2e6, 1.0e6);
 /// file's (seals wear in and out). [1]
 pub const COULOMB_BAND: f64 = 3.0;
 
-/// Upper end of the breakaway force's excess over the Coulomb force's tolerance band, as a
-/// multiple of the rig file's excess (at least 10 N). [1]
+/// Upper end of the breakaway force's tolerance band, as a multiple of the rig file's
+/// static level (seals wear in and out). [1]
 pub const BREAKAWAY_BAND: f64 = 3.0;
+
+/// The breakaway force the band and the search scale from when the rig file's is smaller
+/// (a rig file may switch the cylinder's friction off). [N]
+pub const BREAKAWAY_REFERENCE_FLOOR_N: f64 = 10.0;
 
 /// The cylinder relation of a log whose piston moves.
 pub struct CylinderRelation<'a> {
@@ -117,6 +127,50 @@ impl<'a> CylinderRelation<'a> {
     /// Where the piston rests and breaks away.
     pub fn stick(&self) -> &Stick {
         &self.stick
+    }
+
+    /// Whether the piston rests somewhere in the identification segment: only then does
+    /// the log say anything of the breakaway level (from below by the forces held, from
+    /// above by a breakaway), and only then is it released with the Coulomb force.
+    pub fn sees_rest(&self) -> bool {
+        self.stick.rests[self.facts.identification()]
+            .iter()
+            .any(|r| *r)
+    }
+
+    /// The breakaway level the identification segment shows at the rig file's values: the
+    /// mean of its breakaways' levels, else the largest force held at rest; `None` when the
+    /// piston never rests there. [N]
+    pub fn breakaway_seen(&self) -> Option<f64> {
+        if !self.sees_rest() {
+            return None;
+        }
+        let cyl = Cylinder::new(&self.rig.cylinder);
+        let low_side = self.log.p_low_pa.is_none().then(|| self.nominal_low_side());
+        let ident = self.facts.identification();
+        let levels: Vec<f64> = self
+            .stick
+            .breakaways
+            .iter()
+            .filter(|b| ident.contains(&b.row) && ident.contains(&(b.row + 1)))
+            .map(|b| {
+                let held = |k| self.held_force(&cyl, low_side, k);
+                b.dir * 0.5 * (held(b.row) + held(b.row + 1))
+            })
+            .collect();
+        if !levels.is_empty() {
+            return Some(levels.iter().sum::<f64>() / levels.len() as f64);
+        }
+        ident
+            .filter(|k| self.stick.rests[*k])
+            .map(|k| self.held_force(&cyl, low_side, k).abs())
+            .max_by(f64::total_cmp)
+    }
+
+    /// The low side's pressure the search starts from when the log does not have it. [Pa]
+    fn nominal_low_side(&self) -> f64 {
+        let (lo, hi) = LOW_SIDE_BAND_PA;
+        self.rig.fill.pressure_pa.clamp(lo, hi)
     }
 
     /// The cylinder at `values` and its low-side pressure (`None`: logged).
@@ -186,10 +240,10 @@ impl<'a> CylinderRelation<'a> {
     }
 }
 
-/// The breakaway force F_s at search `values`: the Coulomb force and the excess over it
-/// (never negative, so the clamp's range is never empty). [N]
-fn breakaway_level(values: &[f64]) -> f64 {
-    (values[ix::COULOMB] + values[ix::BREAKAWAY]).max(0.0)
+/// The breakaway force at search `values`: F_s, or F_c where F_s is below it (never
+/// negative, so the clamp's range is never empty). [N]
+pub fn breakaway_level(values: &[f64]) -> f64 {
+    values[ix::BREAKAWAY].max(values[ix::COULOMB]).max(0.0)
 }
 
 impl Relation for CylinderRelation<'_> {
@@ -202,11 +256,15 @@ impl Relation for CylinderRelation<'_> {
         } else {
             coulomb.with_band(0.0, COULOMB_BAND * nominal.max(10.0))
         };
-        let excess = (c.static_friction_n - c.coulomb_friction_n).max(0.0);
-        let mut breakaway = ParamSpec::linear("breakaway_over_coulomb_n", excess, 10.0, 0.0, 20e3);
-        if release != Release::CylinderFriction {
-            breakaway = breakaway.with_band(0.0, BREAKAWAY_BAND * excess.max(10.0));
-        }
+        let reference = c
+            .static_friction_n
+            .max(c.coulomb_friction_n)
+            .max(BREAKAWAY_REFERENCE_FLOOR_N);
+        let mut breakaway = ParamSpec::log("breakaway_n", reference, 1e-2, 2e3);
+        breakaway = match self.breakaway_seen() {
+            Some(seen) if release == Release::CylinderFriction => breakaway.starting_at(seen),
+            _ => breakaway.with_band(1e-2 * reference, BREAKAWAY_BAND * reference),
+        };
         let mut specs = vec![
             ParamSpec::log("mass_kg", c.mass_kg, 0.3, 3.0)
                 .with_band(0.9 * c.mass_kg, 1.1 * c.mass_kg),
@@ -222,7 +280,7 @@ impl Relation for CylinderRelation<'_> {
         ];
         if self.log.p_low_pa.is_none() {
             let (lo, hi) = LOW_SIDE_BAND_PA;
-            let fill = self.rig.fill.pressure_pa.clamp(lo, hi);
+            let fill = self.nominal_low_side();
             specs.push(ParamSpec::linear("low_side_pa", fill, 1e4, 0.0, 5e6).with_band(lo, hi));
         }
         specs
@@ -265,12 +323,17 @@ impl Relation for CylinderRelation<'_> {
 mod tests {
     use super::*;
     use crate::diagnose::calibration::{calibrate, fit_relation, test_release};
+    use crate::diagnose::test_noise::gaussian;
 
     /// Rig file's cylinder (nominal: A = 71 cm², m = 2000 kg, B = 150 N·s/m, no spring,
     /// level) with these friction levels in the plant that made the log. [N]
     const COULOMB_N: f64 = 400.0;
     const BREAKAWAY_N: f64 = 650.0;
     const P_LOW_PA: f64 = 0.5e6;
+    /// White noise on the logged port pressure, a transducer's. [Pa]
+    const NOISE_PA: f64 = 300.0;
+    /// How close the fitted breakaway must come (see the test). [N]
+    const BREAKAWAY_TOLERANCE_N: f64 = 0.5 + 3.0 * 1.5;
 
     /// Time constant of the piston's speed after the breakaway. [s]
     const TAU_S: f64 = 0.1;
@@ -279,7 +342,8 @@ mod tests {
     /// force on it ramps at 1 N per row from −0.4 N, so it reaches F_s at 650.4 ms
     /// (between rows 650 and 651); from then on the friction drops to F_c and the piston
     /// speeds up as v = v_f·(1 − e^(−s/τ)), s = t − t_b, its acceleration at the breakaway
-    /// (F_s − F_c)/m, the force following the balance m·a + B·v + F_c exactly.
+    /// (F_s − F_c)/m, the force following the balance m·a + B·v + F_c exactly. The pressure
+    /// is logged with [`NOISE_PA`] of white noise.
     fn breakaway_log() -> BenchLog {
         let rig = Rig::nominal();
         let c = &rig.cylinder;
@@ -304,7 +368,11 @@ mod tests {
         BenchLog {
             t_s: t,
             p_ref_pa: vec![P_LOW_PA; n],
-            p_pa: force.iter().map(|f| P_LOW_PA + f / area).collect(),
+            p_pa: force
+                .iter()
+                .zip(gaussian(n, 17))
+                .map(|(f, e)| P_LOW_PA + f / area + NOISE_PA * e)
+                .collect(),
             speed_rad_s: vec![0.0; n],
             iq_a: vec![0.0; n],
             id_a: vec![0.0; n],
@@ -327,7 +395,7 @@ mod tests {
         // At rest the friction takes up the drive up to F_s: with F_s = 300 N a row whose
         // drive is 499.6 N is predicted at the breakaway level's pressure, 300 N/A over
         // p_low; one with 199.6 N at its measured pressure.
-        let mut v = vec![2000.0, 150.0, 100.0, 200.0];
+        let mut v = vec![2000.0, 150.0, 100.0, 300.0];
         let mut out = vec![0.0; log.len()];
         rel.predict(&v, 200..601, &mut out);
         assert!(
@@ -338,8 +406,9 @@ mod tests {
         assert!((out[200] - log.p_pa[200]).abs() < 1e-6, "{}", out[200]);
 
         // The calibrated baseline, then both friction levels released: the breakaway comes
-        // out within the half row (0.5 N) its crossing is known to, the Coulomb force within
-        // the percent the central differences' smearing of the breakaway's kink allows.
+        // out within the half row (0.5 N) its crossing is known to and three standard
+        // deviations of the two rows' mean pressure noise (A·σ/√2 = 1.5 N), the Coulomb
+        // force within the percent the central differences' smearing of the kink allows.
         // The whole log after the start skip, in the calibration's one-second windows.
         let rows = facts.windows(facts.identification().start..log.len(), 1.0);
         let t = test_release(
@@ -349,8 +418,11 @@ mod tests {
             &calibrate(&rel, &rows),
         );
         let f = &t.fitted.values;
-        let breakaway = f[ix::COULOMB] + f[ix::BREAKAWAY];
-        assert!((breakaway - BREAKAWAY_N).abs() < 0.6, "{f:?}");
+        let breakaway = breakaway_level(f);
+        assert!(
+            (breakaway - BREAKAWAY_N).abs() < BREAKAWAY_TOLERANCE_N,
+            "{f:?}"
+        );
         assert!(
             (f[ix::COULOMB] - COULOMB_N).abs() < 0.01 * COULOMB_N,
             "{f:?}"
@@ -361,7 +433,25 @@ mod tests {
         v[ix::COULOMB] = COULOMB_N;
         v[ix::BREAKAWAY] = 3000.0;
         let high = fit_relation(&rel, &rows, Release::CylinderFriction, 1.0, Some(&v));
-        let breakaway = high.values[ix::COULOMB] + high.values[ix::BREAKAWAY];
-        assert!((breakaway - BREAKAWAY_N).abs() < 0.6, "{:?}", high.values);
+        let breakaway = breakaway_level(&high.values);
+        assert!(
+            (breakaway - BREAKAWAY_N).abs() < BREAKAWAY_TOLERANCE_N,
+            "{:?}",
+            high.values
+        );
+    }
+
+    #[test]
+    fn a_log_that_never_shows_the_piston_resting_keeps_the_breakaway_in_its_band() {
+        // The same log from 10 ms after the breakaway: the piston slides throughout, the
+        // breakaway level is not in it, and cylinder friction releases the Coulomb force
+        // alone.
+        let rig = Rig::nominal();
+        let log = breakaway_log().tail(661);
+        let facts = LogFacts::of(&log, &rig);
+        let rel = CylinderRelation::of(&log, &facts, &rig).expect("the piston moves");
+        assert!(!rel.sees_rest());
+        let specs = rel.specs(Release::CylinderFriction);
+        assert!(specs[ix::BREAKAWAY].band.is_some() && specs[ix::COULOMB].band.is_none());
     }
 }
