@@ -64,7 +64,7 @@ pub enum Release {
     ShaftFriction,
     /// Inverter dead time (electrical relation).
     DeadTime,
-    /// Cylinder Coulomb friction.
+    /// Cylinder Coulomb friction and, with it, the breakaway's excess over it.
     CylinderFriction,
 }
 
@@ -257,7 +257,16 @@ pub fn test_release<R: Relation>(
         weighed_sse(relation, v, rows, scale) + prior
     };
     let mut start = base.fitted.values.clone();
-    if let Some((k, grid)) = relation.released(release) {
+    // A parameter the release frees besides the grid's starts where the released search
+    // space puts it (read off the log), not at the band's edge the baseline left it at.
+    let grid = relation.released(release);
+    let base_specs = relation.specs(Release::Nothing);
+    for (k, (s, b)) in specs.iter().zip(&base_specs).enumerate() {
+        if s.band.is_none() && b.band.is_some() && grid.as_ref().is_none_or(|(g, _)| *g != k) {
+            start[k] = s.value(s.start);
+        }
+    }
+    if let Some((k, grid)) = grid {
         let best = grid
             .iter()
             .map(|g| {

@@ -8,7 +8,7 @@
 //! | `accumulator_precharge` | hydraulic relation, precharge released | p_0 ±5 % |
 //! | `pressure_sensor_lag` | hydraulic relation, lag released | 0–2.5 ms |
 //! | `shaft_friction` | mechanical relation, Coulomb torque released | 0–0.02 N·m |
-//! | `cylinder_friction` | cylinder relation, Coulomb force released | 0–3× the rig's |
+//! | `cylinder_friction` | cylinder relation, Coulomb and breakaway force released together (the breakaway where the piston rests) | each 0–3× the rig's |
 //! | `dead_time` | electrical relation (voltages logged), else the d/q current lines at 6·p_n | 0–0.1 µs |
 //! | `cogging_torque` | torque line at the slot order | 0.01 N·m |
 //! | `flux_harmonics` | torque line at 6·p_n ∝ mean torque, and (angle logged) its back-EMF's current lines | 0.5 % |
@@ -26,10 +26,12 @@ use crate::diagnose::angle_locked::{
 use crate::diagnose::calibration::{
     hyd, mech, test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
 };
+use crate::diagnose::cylinder;
 use crate::diagnose::dead_time::{
     dead_time_gain, fit_dead_time, DeadTimeFit, REFERENCE_DEAD_TIME_S,
 };
 use crate::diagnose::hydraulic::nominal_leakage;
+use crate::diagnose::least_squares::ParamSpec;
 use crate::diagnose::lines::WindowLines;
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::Rig;
@@ -87,6 +89,35 @@ pub struct Tested {
     pub extension: Extension,
 }
 
+/// The catalogue's effect a release tests, the indices of the parameters it may release
+/// (the first the main one) and the extension at the released values `v`.
+fn released_effect(release: Release, v: &[f64]) -> (&'static [usize], &'static str, Extension) {
+    let v = v.to_vec();
+    match release {
+        Release::Leakage => (&[hyd::LEAKAGE], "extra_leakage", Extension::Hydraulic(v)),
+        Release::BulkModulus => (&[hyd::BETA], "entrained_air", Extension::Hydraulic(v)),
+        Release::Precharge => (
+            &[hyd::PRECHARGE],
+            "accumulator_precharge",
+            Extension::Hydraulic(v),
+        ),
+        Release::SensorLag => (&[hyd::LAG], "pressure_sensor_lag", Extension::Hydraulic(v)),
+        Release::ShaftFriction => (&[mech::COULOMB], "shaft_friction", Extension::Mechanical(v)),
+        Release::DeadTime => (
+            &[crate::diagnose::electrical::ix::DEAD_TIME],
+            "dead_time",
+            Extension::Electrical(v),
+        ),
+        // The breakaway is released with the Coulomb force: two parameters.
+        Release::CylinderFriction => (
+            &[cylinder::ix::COULOMB, cylinder::ix::BREAKAWAY],
+            "cylinder_friction",
+            Extension::Cylinder(v),
+        ),
+        Release::Nothing => (&[0], "none", Extension::Hydraulic(v)),
+    }
+}
+
 /// A released parameter's test in the catalogue's terms.
 pub fn from_release<R: Relation>(
     relation: &R,
@@ -97,54 +128,26 @@ pub fn from_release<R: Relation>(
     let v = &test.fitted.values;
     let specs = relation.specs(test.release);
     let base_specs = relation.specs(Release::Nothing);
-    let (index, effect, extension) = match test.release {
-        Release::Leakage => (
-            hyd::LEAKAGE,
-            "extra_leakage",
-            Extension::Hydraulic(v.clone()),
-        ),
-        Release::BulkModulus => (hyd::BETA, "entrained_air", Extension::Hydraulic(v.clone())),
-        Release::Precharge => (
-            hyd::PRECHARGE,
-            "accumulator_precharge",
-            Extension::Hydraulic(v.clone()),
-        ),
-        Release::SensorLag => (
-            hyd::LAG,
-            "pressure_sensor_lag",
-            Extension::Hydraulic(v.clone()),
-        ),
-        Release::ShaftFriction => (
-            mech::COULOMB,
-            "shaft_friction",
-            Extension::Mechanical(v.clone()),
-        ),
-        Release::DeadTime => (
-            crate::diagnose::electrical::ix::DEAD_TIME,
-            "dead_time",
-            Extension::Electrical(v.clone()),
-        ),
-        Release::CylinderFriction => (
-            crate::diagnose::cylinder::ix::COULOMB,
-            "cylinder_friction",
-            Extension::Cylinder(v.clone()),
-        ),
-        Release::Nothing => (0, "none", Extension::Hydraulic(v.clone())),
-    };
-    let u = test.fitted.u[index];
+    let (all, effect, extension) = released_effect(test.release, v);
+    // The main parameter, and the others the relation released on this log (the
+    // cylinder's breakaway only where the piston is seen resting).
+    let indices: Vec<usize> = all
+        .iter()
+        .enumerate()
+        .filter(|(n, i)| *n == 0 || specs[**i].band.is_none())
+        .map(|(_, i)| *i)
+        .collect();
     // Outside its band: the released estimate lies beyond it. That it lies there
     // significantly is the likelihood ratio itself: the baseline is the best fit with the
     // parameter held within the band (at its edge, when the data pull outwards), so Λ is
     // the profile likelihood ratio of the band's edge against the estimate — a test that
     // needs no covariance of the nuisance parameters, which flat bands leave singular along
     // the directions the log does not fix.
-    let outside_band = match base_specs[index].band {
-        Some((lo, hi)) => u > hi || u < lo,
+    let outside_band = indices.iter().any(|&i| match base_specs[i].band {
+        Some((lo, hi)) => test.fitted.u[i] > hi || test.fitted.u[i] < lo,
         None => false,
-    };
-    let value = specs[index].value(u);
-    let se = test.fitted.standard_error(index, 1.0);
-    let spread = (specs[index].value(u + se) - value).abs();
+    });
+    let value = specs[indices[0]].value(test.fitted.u[indices[0]]);
     let parameters = match test.release {
         Release::Leakage => vec![("coefficient_m3_s_pa", value - nominal_leakage(rig))],
         Release::BulkModulus => {
@@ -157,8 +160,12 @@ pub fn from_release<R: Relation>(
         Release::ShaftFriction => vec![("coulomb_nm", value), ("static_nm", value)],
         Release::DeadTime => vec![("dead_time_s", value)],
         Release::CylinderFriction => {
-            let extra = (value - rig.cylinder.coulomb_friction_n).max(0.0);
-            vec![("coulomb_n", extra), ("static_n", extra)]
+            // Both levels beyond the rig file's; the plant raises a breakaway below the
+            // Coulomb level to it.
+            let c = &rig.cylinder;
+            let coulomb = (value - c.coulomb_friction_n).max(0.0);
+            let static_n = (cylinder::breakaway_level(v) - c.static_friction_n).max(coulomb);
+            vec![("coulomb_n", coulomb), ("static_n", static_n)]
         }
         Release::Nothing => Vec::new(),
     };
@@ -166,26 +173,48 @@ pub fn from_release<R: Relation>(
         weighed_sse(relation, &test.baseline.values, validation, test.scale)
             - weighed_sse(relation, &test.fitted.values, validation, test.scale)
     });
-    let evidence = format!(
-        "{} released from its tolerance band to {} (± {} at one standard error, band {}): \
-         Λ = {:.1} on the identification segment",
-        specs[index].name,
-        short(value),
-        short(spread),
-        band_text(&base_specs[index]),
-        test.lambda
-    );
     Tested {
         effect,
         parameters,
         lambda: test.lambda,
-        dof: 1,
+        dof: indices.len(),
         outside_band,
         validation_gain,
         veto: None,
-        evidence,
+        evidence: release_evidence(test, &indices, &specs, &base_specs),
         extension,
     }
+}
+
+/// What a release measured, in words: each released parameter's estimate, its standard
+/// error and band, and Λ.
+fn release_evidence(
+    test: &ReleaseTest,
+    indices: &[usize],
+    specs: &[ParamSpec],
+    base_specs: &[ParamSpec],
+) -> String {
+    let released: Vec<String> = indices
+        .iter()
+        .map(|&i| {
+            let u = test.fitted.u[i];
+            let value = specs[i].value(u);
+            let se = test.fitted.standard_error(i, 1.0);
+            let spread = (specs[i].value(u + se) - value).abs();
+            format!(
+                "{} released from its tolerance band to {} (± {} at one standard error, band {})",
+                specs[i].name,
+                short(value),
+                short(spread),
+                band_text(&base_specs[i])
+            )
+        })
+        .collect();
+    format!(
+        "{}: Λ = {:.1} on the identification segment",
+        released.join(", "),
+        test.lambda
+    )
 }
 
 fn short(v: f64) -> String {
@@ -196,7 +225,7 @@ fn short(v: f64) -> String {
     }
 }
 
-fn band_text(s: &crate::diagnose::least_squares::ParamSpec) -> String {
+fn band_text(s: &ParamSpec) -> String {
     match s.band {
         Some((lo, hi)) => format!("{}–{}", short(s.value(lo)), short(s.value(hi))),
         None => "none".into(),

@@ -43,6 +43,9 @@ pub mod report;
 pub mod result;
 pub mod signatures;
 pub mod spectrum;
+pub mod stick;
+#[cfg(test)]
+mod test_noise;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 
