@@ -13,7 +13,7 @@
 //! 7. [`super::result`]: the scores, the evidence for the report (residual signatures and
 //!    order spectra of the baseline) and the contract's result.
 
-use super::angle_locked::ShaftConstants;
+use super::angle_locked::{LineReading, ShaftConstants};
 use super::calibration::{
     calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Patient, Release,
     HYDRAULIC_WINDOW_S,
@@ -344,7 +344,11 @@ pub fn analyse_reporting(
         shaft,
         orders,
         &[rig.motor.cogging_fundamental_order()],
-        facts.angle_logged,
+        LineReading {
+            coherent: facts.angle_logged,
+            // The voltages, when logged, carry the back-EMF themselves.
+            back_emf: rel.electrical.is_none(),
+        },
     );
     // With the voltages logged the electrical relation reads the dead time directly.
     if rel.electrical.is_some() {

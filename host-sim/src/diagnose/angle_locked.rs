@@ -127,6 +127,8 @@ pub struct LineFit {
     pub windows: usize,
     /// Whether the phases were combined (the angle was logged).
     pub coherent: bool,
+    /// Whether the flux harmonics' back-EMF lines were fitted with the torque line.
+    pub back_emf: bool,
 }
 
 /// One line an effect explains in one window: measured, what one unit of the amplitude
@@ -141,14 +143,14 @@ struct Observation {
 }
 
 /// The lines `effect` explains in window `w`: its torque line, and, for flux harmonics
-/// with the angle logged, the back-EMF's q- and d-current lines.
+/// with `back_emf`, the back-EMF's q- and d-current lines.
 fn observations(
     effect: LineEffect,
     w: &WindowLines,
     rig: &Rig,
     shaft: ShaftConstants,
     candidates: &[u32],
-    coherent: bool,
+    back_emf: bool,
 ) -> Vec<Observation> {
     let ShaftConstants { kt, j, d_per_rad } = shaft;
     let Some(o) = w.at(effect.order(rig)) else {
@@ -169,7 +171,7 @@ fn observations(
             free_d: false,
         });
     }
-    if effect == LineEffect::FluxHarmonics && coherent {
+    if effect == LineEffect::FluxHarmonics && back_emf {
         if let Some([q, d]) = back_emf_lines(w, o, rig, candidates) {
             for (l, free_d) in [(q, false), (d, true)] {
                 out.push(Observation {
@@ -198,18 +200,31 @@ fn amplitude_of(obs: &[Observation], free_d: bool) -> Option<(Complex64, f64)> {
     })
 }
 
-/// Fits `effect` to the windows `lines` (already restricted to the segment wanted).
+/// How the lines of a log are read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LineReading {
+    /// The angle is logged: the windows' phases are combined.
+    pub coherent: bool,
+    /// The angle is logged and the voltages are not: the flux harmonics are fitted with
+    /// their back-EMF's current lines ([`super::back_emf`]).
+    pub back_emf: bool,
+}
+
+/// Fits `effect` to the windows `lines` (already restricted to the segment wanted), read
+/// as `reading` says.
 pub fn fit_line(
     effect: LineEffect,
     lines: &[&WindowLines],
     rig: &Rig,
     shaft: ShaftConstants,
     candidates: &[u32],
-    coherent: bool,
+    reading: LineReading,
 ) -> Option<LineFit> {
+    let coherent = reading.coherent;
+    let back_emf = reading.back_emf && coherent;
     let per_window: Vec<Vec<Observation>> = lines
         .iter()
-        .map(|w| observations(effect, w, rig, shaft, candidates, coherent))
+        .map(|w| observations(effect, w, rig, shaft, candidates, back_emf))
         .filter(|o| !o.is_empty())
         .collect();
     let obs: Vec<Observation> = per_window.iter().flatten().copied().collect();
@@ -242,6 +257,7 @@ pub fn fit_line(
         dof,
         windows: per_window.len(),
         coherent,
+        back_emf: back_emf && effect == LineEffect::FluxHarmonics,
     })
 }
 
@@ -258,7 +274,7 @@ pub fn line_gain(
     let mut gain = 0.0;
     let mut n = 0;
     for w in lines {
-        for o in observations(fit.effect, w, rig, shaft, candidates, fit.coherent) {
+        for o in observations(fit.effect, w, rig, shaft, candidates, fit.back_emf) {
             let predicted = if !fit.coherent {
                 // Only the magnitude is known: the best phase, i.e. the magnitudes compared.
                 o.line

@@ -21,7 +21,8 @@
 //! the validation segment in the same units.
 
 use crate::diagnose::angle_locked::{
-    fit_line, line_gain, offset_from_line, plant_phase, LineEffect, LineFit, ShaftConstants,
+    fit_line, line_gain, offset_from_line, plant_phase, LineEffect, LineFit, LineReading,
+    ShaftConstants,
 };
 use crate::diagnose::calibration::{
     hyd, mech, test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
@@ -258,7 +259,7 @@ pub fn test_lines(
     shaft: ShaftConstants,
     orders: &[u32],
     cogging_orders: &[u32],
-    coherent: bool,
+    reading: LineReading,
 ) -> Vec<Tested> {
     let mut effects = vec![LineEffect::CurrentOffset, LineEffect::FluxHarmonics];
     effects.extend(cogging_orders.iter().map(|k| LineEffect::Cogging(*k)));
@@ -266,7 +267,7 @@ pub fn test_lines(
     let mut out: Vec<Tested> = effects
         .into_iter()
         .filter_map(|e| {
-            let f = fit_line(e, identification, rig, shaft, orders, coherent)?;
+            let f = fit_line(e, identification, rig, shaft, orders, reading)?;
             let gain = line_gain(&f, validation, rig, shaft, orders);
             Some(line_verdict(f, gain, rig, shaft.kt))
         })
@@ -328,7 +329,7 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
             ),
         ),
     };
-    let with_emf = if f.dof == 4 {
+    let with_emf = if f.back_emf {
         " with its back-EMF's d- and q-current lines"
     } else {
         ""

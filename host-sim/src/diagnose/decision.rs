@@ -84,8 +84,7 @@ pub fn apply_vetoes(tested: &mut [Tested]) {
     };
     let margin = |t: &Tested| t.lambda - threshold(t.dof);
     let (mf, md) = (margin(&tested[f]), margin(&tested[d]));
-    let joint =
-        matches!(&tested[f].extension, Extension::TorqueLine(l) if l.coherent && l.dof == 4);
+    let joint = matches!(&tested[f].extension, Extension::TorqueLine(l) if l.back_emf);
     if joint && mf > 0.0 && mf >= md {
         tested[d].veto = Some(format!(
             "the flux harmonics explain the current lines at 6·p_n better (Λ − threshold \

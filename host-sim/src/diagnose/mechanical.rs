@@ -102,6 +102,9 @@ pub struct ShaftMotion {
     pub speed_rad_s: Vec<f64>,
     /// Acceleration. [rad/s²]
     pub accel_rad_s2: Vec<f64>,
+    /// The q current's moving mean ([`MEAN_CURRENT_HALF_WIDTH_S`]), which scales the flux
+    /// harmonics' torque line. [A]
+    pub iq_mean_a: Vec<f64>,
 }
 
 /// Central difference of `y` against `t` over ±`h` rows, clipped at the ends.
@@ -166,6 +169,7 @@ impl ShaftMotion {
         ShaftMotion {
             speed_rad_s: speed,
             accel_rad_s2: accel,
+            iq_mean_a: mean_current(&log.iq_a, facts.period_s),
         }
     }
 }
@@ -250,7 +254,7 @@ impl Mechanics {
         out: &mut [f64],
     ) {
         let j = self.params.inertia_kg_m2;
-        let slow = mean_current(&log.iq_a, facts.period_s);
+        let slow = &motion.iq_mean_a;
         for k in rows {
             let w = motion.speed_rad_s[k];
             let need = self.load_torque(log, facts, k, w) + j * motion.accel_rad_s2[k];
@@ -273,7 +277,7 @@ impl Mechanics {
     ) {
         let t = &log.t_s;
         let j = self.params.inertia_kg_m2.max(1e-12);
-        let slow = mean_current(&log.iq_a, facts.period_s);
+        let slow = &motion.iq_mean_a;
         for win in windows {
             let mut w = motion.speed_rad_s[win.start];
             out[win.start] = w;
