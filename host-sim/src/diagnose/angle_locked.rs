@@ -17,7 +17,7 @@
 //! K_t and J could leave of the measured current and angle lines ([`TORQUE_TOLERANCE`]):
 //! a voltage disturbance moving current and angle together cannot pass for a torque.
 
-use crate::diagnose::back_emf::back_emf_lines;
+use crate::diagnose::back_emf::{back_emf_lines, LineObservation};
 use crate::diagnose::lines::{OrderLines, WindowLines};
 use plant_model::motor::Motor;
 use plant_model::Rig;
@@ -131,14 +131,11 @@ pub struct LineFit {
     pub back_emf: bool,
 }
 
-/// One line an effect explains in one window: measured, what one unit of the amplitude
-/// makes of it, its noise variance per real component, and whether it follows the flux
-/// harmonics' free d-axis amplitude instead of the effect's own.
+/// One line an effect explains in one window, and whether it follows the flux harmonics'
+/// free d-axis amplitude instead of the effect's own.
 #[derive(Clone, Copy, Debug)]
 struct Observation {
-    line: Complex64,
-    regressor: Complex64,
-    var: f64,
+    of: LineObservation,
     free_d: bool,
 }
 
@@ -165,22 +162,24 @@ fn observations(
     let x = regressor(effect, w, kt, ripple_per_ratio, d_per_rad);
     if var.is_finite() && x.abs() > 0.0 {
         out.push(Observation {
-            line: o.torque,
-            regressor: Complex64::new(x, 0.0),
-            var,
+            of: LineObservation {
+                line: o.torque,
+                regressor: Complex64::new(x, 0.0),
+                var,
+            },
             free_d: false,
         });
     }
     if effect == LineEffect::FluxHarmonics && back_emf {
         if let Some([q, d]) = back_emf_lines(w, o, rig, candidates) {
-            for (l, free_d) in [(q, false), (d, true)] {
-                out.push(Observation {
-                    line: l.line,
-                    regressor: l.regressor,
-                    var: l.var,
-                    free_d,
-                });
-            }
+            out.push(Observation {
+                of: q,
+                free_d: false,
+            });
+            out.push(Observation {
+                of: d,
+                free_d: true,
+            });
         }
     }
     out
@@ -189,7 +188,7 @@ fn observations(
 /// The weighted least-squares amplitude of `obs` (those with `free_d` as given) and its
 /// information; `None` without information.
 fn amplitude_of(obs: &[Observation], free_d: bool) -> Option<(Complex64, f64)> {
-    let group = obs.iter().filter(|o| o.free_d == free_d);
+    let group = obs.iter().filter(|o| o.free_d == free_d).map(|o| &o.of);
     let info: f64 = group.clone().map(|o| o.regressor.norm_sqr() / o.var).sum();
     (info > 0.0).then(|| {
         let a = group
@@ -228,6 +227,7 @@ pub fn fit_line(
         .filter(|o| !o.is_empty())
         .collect();
     let obs: Vec<Observation> = per_window.iter().flatten().copied().collect();
+    let lines_of = || obs.iter().map(|o| &o.of);
     let (amplitude, information) = amplitude_of(&obs, false)?;
     let (amplitude, back_emf_d, lambda, dof) = if coherent {
         let (d, d_info) = amplitude_of(&obs, true).unwrap_or_default();
@@ -235,12 +235,11 @@ pub fn fit_line(
         (amplitude, d, lambda, if d_info > 0.0 { 4 } else { 2 })
     } else {
         // Only magnitudes: the torque lines' (the only observations without the angle).
-        let a = obs
-            .iter()
+        let a = lines_of()
             .map(|o| o.line.norm() * o.regressor.norm() / o.var)
             .sum::<f64>()
             / information;
-        let l = obs.iter().map(|o| o.line.norm_sqr() / o.var).sum::<f64>();
+        let l = lines_of().map(|o| o.line.norm_sqr() / o.var).sum::<f64>();
         (
             Complex64::new(a, 0.0),
             Complex64::default(),
@@ -274,12 +273,14 @@ pub fn line_gain(
     let mut gain = 0.0;
     let mut n = 0;
     for w in lines {
-        for o in observations(fit.effect, w, rig, shaft, candidates, fit.back_emf) {
+        for Observation { of: o, free_d } in
+            observations(fit.effect, w, rig, shaft, candidates, fit.back_emf)
+        {
             let predicted = if !fit.coherent {
                 // Only the magnitude is known: the best phase, i.e. the magnitudes compared.
                 o.line
                     * (fit.amplitude.re * o.regressor.norm() / o.line.norm().max(f64::MIN_POSITIVE))
-            } else if o.free_d {
+            } else if free_d {
                 fit.back_emf_d * o.regressor
             } else {
                 fit.amplitude * o.regressor

@@ -43,14 +43,15 @@ use rustfft::num_complex::Complex64;
 /// Table 1 gains and inductances. [1]
 pub const LOOP_TOLERANCE: f64 = 0.25;
 
-/// One current line the flux harmonics' back-EMF explains.
+/// One measured line an amplitude explains: the line, what one unit of the amplitude makes
+/// of it, and its noise variance per real component.
 #[derive(Clone, Copy, Debug)]
-pub struct BackEmfLine {
-    /// The measured line. [A]
+pub struct LineObservation {
+    /// The measured line. [unit of the signal]
     pub line: Complex64,
-    /// The line one unit of amplitude makes. [A]
+    /// The line one unit of amplitude makes. [unit of the signal]
     pub regressor: Complex64,
-    /// Noise variance per real component, with the loop model's uncertainty. [A²]
+    /// Noise variance per real component, with the model's uncertainty. [unit²]
     pub var: f64,
 }
 
@@ -79,7 +80,7 @@ pub fn back_emf_lines(
     o: &OrderLines,
     rig: &Rig,
     candidates: &[u32],
-) -> Option<[BackEmfLine; 2]> {
+) -> Option<[LineObservation; 2]> {
     let speed = w.window.speed_rad_s;
     let freq = o.order as f64 * speed;
     if freq == 0.0 {
@@ -97,12 +98,12 @@ pub fn back_emf_lines(
     let share = -(current_tracking(rig, freq) * speed_reference_per_angle(rig, freq)) * o.theta;
     let q_line = o.iq - share;
     Some([
-        BackEmfLine {
+        LineObservation {
             line: q_line,
             regressor: hq * emf_per_unit,
             var: floor_q + tol(q_line) + tol(share),
         },
-        BackEmfLine {
+        LineObservation {
             line: o.id,
             regressor: hd * emf_per_unit,
             var: floor_d + tol(o.id),

@@ -31,6 +31,7 @@ use crate::diagnose::cylinder;
 use crate::diagnose::dead_time::{
     dead_time_gain, fit_dead_time, DeadTimeFit, REFERENCE_DEAD_TIME_S,
 };
+use crate::diagnose::electrical::DEAD_TIME_BAND_S;
 use crate::diagnose::hydraulic::nominal_leakage;
 use crate::diagnose::least_squares::ParamSpec;
 use crate::diagnose::lines::WindowLines;
@@ -44,8 +45,6 @@ pub const COGGING_BAND_NM: f64 = 0.01;
 pub const FLUX_BAND: f64 = 0.005;
 /// Current-sensor offset a calibrated channel is granted. [A]
 pub const OFFSET_BAND_A: f64 = 0.03;
-/// Dead time a compensated inverter is granted. [s]
-pub const DEAD_TIME_BAND_S: f64 = 0.1e-6;
 
 /// The usual odd piston counts of axial piston pumps, the ones the diagnosis tries.
 pub const RIPPLE_PISTONS: [u32; 3] = [7, 9, 11];
