@@ -13,7 +13,8 @@
 //! 7. [`super::result`]: the scores, the evidence for the report (residual signatures and
 //!    order spectra of the baseline) and the contract's result.
 
-use super::angle_locked::{LineReading, ShaftConstants};
+use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
+use super::back_emf::Stator;
 use super::calibration::{
     calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Patient, Release,
     HYDRAULIC_WINDOW_S,
@@ -306,6 +307,17 @@ fn test_relations(
     tested
 }
 
+/// The stator constants of the electrical relation's search `values`.
+fn stator(values: &[f64]) -> Stator {
+    use super::electrical::ix;
+    Stator {
+        r_s_ohm: values[ix::R],
+        l_d_h: values[ix::LD],
+        l_q_h: values[ix::LQ],
+        psi_f_wb: values[ix::PSI],
+    }
+}
+
 /// Runs the whole diagnosis, reporting each finished step to `progress`.
 pub fn analyse_reporting(
     log: &BenchLog,
@@ -346,8 +358,10 @@ pub fn analyse_reporting(
         &[rig.motor.cogging_fundamental_order()],
         LineReading {
             coherent: facts.angle_logged,
-            // The voltages, when logged, carry the back-EMF themselves.
-            back_emf: rel.electrical.is_none(),
+            emf: match &cal.electrical {
+                Some(c) => EmfLines::Voltages(stator(&c.fitted.values)),
+                None => EmfLines::Currents,
+            },
         },
     );
     // With the voltages logged the electrical relation reads the dead time directly.

@@ -17,7 +17,7 @@
 //! K_t and J could leave of the measured current and angle lines ([`TORQUE_TOLERANCE`]):
 //! a voltage disturbance moving current and angle together cannot pass for a torque.
 
-use crate::diagnose::back_emf::{back_emf_lines, LineObservation};
+use crate::diagnose::back_emf::{back_emf_lines, voltage_lines, LineObservation, Stator};
 use crate::diagnose::lines::{OrderLines, WindowLines};
 use plant_model::motor::Motor;
 use plant_model::Rig;
@@ -127,8 +127,8 @@ pub struct LineFit {
     pub windows: usize,
     /// Whether the phases were combined (the angle was logged).
     pub coherent: bool,
-    /// Whether the flux harmonics' back-EMF lines were fitted with the torque line.
-    pub back_emf: bool,
+    /// The flux harmonics' back-EMF lines fitted with the torque line.
+    pub emf: EmfLines,
 }
 
 /// One line an effect explains in one window, and whether it follows the flux harmonics'
@@ -139,15 +139,15 @@ struct Observation {
     free_d: bool,
 }
 
-/// The lines `effect` explains in window `w`: its torque line, and, for flux harmonics
-/// with `back_emf`, the back-EMF's q- and d-current lines.
+/// The lines `effect` explains in window `w`: its torque line, and, for flux harmonics,
+/// the back-EMF's lines `emf` says.
 fn observations(
     effect: LineEffect,
     w: &WindowLines,
     rig: &Rig,
     shaft: ShaftConstants,
     candidates: &[u32],
-    back_emf: bool,
+    emf: EmfLines,
 ) -> Vec<Observation> {
     let ShaftConstants { kt, j, d_per_rad } = shaft;
     let Some(o) = w.at(effect.order(rig)) else {
@@ -170,8 +170,13 @@ fn observations(
             free_d: false,
         });
     }
-    if effect == LineEffect::FluxHarmonics && back_emf {
-        if let Some([q, d]) = back_emf_lines(w, o, rig, candidates) {
+    if effect == LineEffect::FluxHarmonics {
+        let lines = match emf {
+            EmfLines::None => None,
+            EmfLines::Currents => back_emf_lines(w, o, rig, candidates),
+            EmfLines::Voltages(s) => voltage_lines(w, o, rig, &s, candidates),
+        };
+        if let Some([q, d]) = lines {
             out.push(Observation {
                 of: q,
                 free_d: false,
@@ -199,14 +204,36 @@ fn amplitude_of(obs: &[Observation], free_d: bool) -> Option<(Complex64, f64)> {
     })
 }
 
+/// Which lines carry the flux harmonics' back-EMF beside their torque line
+/// ([`super::back_emf`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EmfLines {
+    /// None: the torque line alone (the angle is not logged).
+    None,
+    /// The d- and q-current lines, as the current loops pass it (no voltages logged).
+    Currents,
+    /// The logged voltages' lines less the stator equations at these constants.
+    Voltages(Stator),
+}
+
+impl EmfLines {
+    /// The lines' description in the evidence.
+    pub fn describe(self) -> &'static str {
+        match self {
+            EmfLines::None => "",
+            EmfLines::Currents => " with its back-EMF's d- and q-current lines",
+            EmfLines::Voltages(_) => " with its back-EMF in the d and q voltages",
+        }
+    }
+}
+
 /// How the lines of a log are read.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LineReading {
     /// The angle is logged: the windows' phases are combined.
     pub coherent: bool,
-    /// The angle is logged and the voltages are not: the flux harmonics are fitted with
-    /// their back-EMF's current lines ([`super::back_emf`]).
-    pub back_emf: bool,
+    /// The back-EMF lines the flux harmonics are fitted with (only with the angle).
+    pub emf: EmfLines,
 }
 
 /// Fits `effect` to the windows `lines` (already restricted to the segment wanted), read
@@ -220,10 +247,13 @@ pub fn fit_line(
     reading: LineReading,
 ) -> Option<LineFit> {
     let coherent = reading.coherent;
-    let back_emf = reading.back_emf && coherent;
+    let emf = match effect {
+        LineEffect::FluxHarmonics if coherent => reading.emf,
+        _ => EmfLines::None,
+    };
     let per_window: Vec<Vec<Observation>> = lines
         .iter()
-        .map(|w| observations(effect, w, rig, shaft, candidates, back_emf))
+        .map(|w| observations(effect, w, rig, shaft, candidates, emf))
         .filter(|o| !o.is_empty())
         .collect();
     let obs: Vec<Observation> = per_window.iter().flatten().copied().collect();
@@ -256,7 +286,7 @@ pub fn fit_line(
         dof,
         windows: per_window.len(),
         coherent,
-        back_emf: back_emf && effect == LineEffect::FluxHarmonics,
+        emf,
     })
 }
 
@@ -274,7 +304,7 @@ pub fn line_gain(
     let mut n = 0;
     for w in lines {
         for Observation { of: o, free_d } in
-            observations(fit.effect, w, rig, shaft, candidates, fit.back_emf)
+            observations(fit.effect, w, rig, shaft, candidates, fit.emf)
         {
             let predicted = if !fit.coherent {
                 // Only the magnitude is known: the best phase, i.e. the magnitudes compared.

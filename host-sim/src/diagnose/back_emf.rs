@@ -1,5 +1,5 @@
-//! The flux harmonics' back-EMF in the d- and q-current lines at order 6·p_n, for logs
-//! without stator voltages.
+//! The flux harmonics' back-EMF at order 6·p_n: in the d- and q-current lines when the
+//! log has no stator voltages, in the commanded voltages' lines when it has them.
 //!
 //! A magnet flux whose d-q image ripples at 6·θ_e (the 5th and 7th harmonics, eq. 17–18)
 //! both ripples the torque (eq. 19) and induces a back-EMF. Power balance fixes the q part:
@@ -13,12 +13,14 @@
 //! whatever the split between the 5th and the 7th. The d part depends on that split (zero
 //! when 5·ψ_5 = −7·ψ_7, as large as E_q for a lone 5th or 7th), which the effects contract
 //! leaves open: it enters as a free complex amplitude, proportional to ψ_f·ω_e as any
-//! back-EMF is.
+//! back-EMF is. In the amplitude a = −r·e^{jφ} the torque line fits (the unexplained
+//! torque line is minus the effect's), E_q = −ψ_f·ω_e·a.
 //!
-//! The current loops pass a voltage E as the line −H(jw)·E ([`disturbance_sensitivity`],
-//! w = 6·p_n·ω̄), and the q loop also follows its reference, which the speed loop moves
-//! against the shaft's oscillation: I_q,ref = −C_ω(jw)·jw·Θ with Θ the logged angle's line
-//! and C_ω = K_p + K_i/(jw) + B_a (Table 1 with the active damping), followed by
+//! **Without the voltages** ([`back_emf_lines`]) the current loops pass a voltage E as the
+//! line −H(jw)·E ([`disturbance_sensitivity`], w = 6·p_n·ω̄), and the q loop also follows
+//! its reference, which the speed loop moves against the shaft's oscillation:
+//! I_q,ref = −C_ω(jw)·jw·Θ with Θ the logged angle's line and C_ω = K_p + K_i/(jw) + B_a
+//! (Table 1 with the active damping), followed by
 //! G_i = (K_p·s + K_i)/(L·s² + (R + K_p)·s + K_i). Of the q-current line the back-EMF's is
 //! therefore what the measured oscillation does not account for:
 //!
@@ -26,13 +28,23 @@
 //!   Y_q = I_q + G_i(jw)·C_ω(jw)·jw·Θ = H_q(jw)·ψ_f·ω_e·a
 //! ```
 //!
-//! where a = −r·e^{jφ} is the same amplitude the torque line fits (the unexplained torque
-//! line is minus the effect's). The speed loop's share is taken from the shaft's measured
-//! oscillation rather than from a model of the shaft's response, so the shaft's load and
-//! inertia do not enter. The loops are the rig's Table 1 design; a bench's own controller
-//! and parts differ (the line's size then follows the bench's current-loop gains), so each
-//! line carries, beside its noise floor, a model uncertainty of [`LOOP_TOLERANCE`] of the
-//! terms computed with them.
+//! The speed loop's share is taken from the shaft's measured oscillation rather than from a
+//! model of the shaft's response, so the shaft's load and inertia do not enter. The loops
+//! are the rig's Table 1 design; a bench's own controller and parts differ (the line's size
+//! then follows the bench's current-loop gains), so each line carries, beside its noise
+//! floor, a model uncertainty of [`LOOP_TOLERANCE`] of the terms computed with them.
+//!
+//! **With the voltages** ([`voltage_lines`]) no loop enters: the stator equations (eq.
+//! 1–2) at one order, with the speed's line jw·Θ from the logged angle,
+//!
+//! ```text
+//!   Y_q = U_q − (R + jw·L_q)·I_q − ω̄_e·L_d·I_d − p_n·(L_d·ī_d + ψ_f)·jw·Θ = −ψ_f·ω̄_e·a
+//!   Y_d = U_d − (R + jw·L_d)·I_d + ω̄_e·L_q·I_q + p_n·L_q·ī_q·jw·Θ        = ψ_f·ω̄_e·b
+//! ```
+//!
+//! leave the back-EMF's lines, whatever controller commanded the voltages (b the free d
+//! amplitude). Each carries the calibrated stator constants' tolerances
+//! ([`STATOR_TOLERANCE`]) on the terms computed with them.
 
 use crate::diagnose::dead_time::disturbance_sensitivity;
 use crate::diagnose::lines::{OrderLines, WindowLines};
@@ -53,6 +65,104 @@ pub struct LineObservation {
     pub regressor: Complex64,
     /// Noise variance per real component, with the model's uncertainty. [unit²]
     pub var: f64,
+}
+
+/// Relative uncertainty of the calibrated resistance, inductances and flux linkage in the
+/// voltage lines: R, L and ψ_f in that order (winding temperature, saturation, magnets). [1]
+pub const STATOR_TOLERANCE: [f64; 3] = [0.2, 0.1, 0.05];
+
+/// The stator constants the voltage lines are read with (the electrical relation's
+/// calibration).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stator {
+    /// Phase resistance. [Ω]
+    pub r_s_ohm: f64,
+    /// d inductance. [H]
+    pub l_d_h: f64,
+    /// q inductance. [H]
+    pub l_q_h: f64,
+    /// Magnet flux linkage. [Wb]
+    pub psi_f_wb: f64,
+}
+
+/// The voltages' lines at one order less what the stator equations make of the current and
+/// speed lines: the back-EMF lines (Y_d, Y_q) the model lacks and the variance the
+/// stator's tolerances leave on each; `None` without the voltages. [V, V²]
+fn voltage_residuals(
+    w: &WindowLines,
+    o: &OrderLines,
+    rig: &Rig,
+    s: &Stator,
+) -> Option<([Complex64; 2], [f64; 2])> {
+    let [u_d, u_q] = o.voltages?;
+    let pp = rig.motor.pole_pairs as f64;
+    let speed = w.window.speed_rad_s;
+    let jw = Complex64::new(0.0, o.order as f64 * speed);
+    let w_e = pp * speed;
+    let [tr, tl, tpsi] = STATOR_TOLERANCE;
+    let rate = jw * o.theta * pp;
+    let q_terms = [
+        (s.r_s_ohm * o.iq, tr),
+        (jw * s.l_q_h * o.iq, tl),
+        (w_e * s.l_d_h * o.id, tl),
+        (rate * s.l_d_h * w.id_mean_a, tl),
+        (rate * s.psi_f_wb, tpsi),
+    ];
+    let d_terms = [
+        (s.r_s_ohm * o.id, tr),
+        (jw * s.l_d_h * o.id, tl),
+        (-w_e * s.l_q_h * o.iq, tl),
+        (-rate * s.l_q_h * w.iq_mean_a, tl),
+    ];
+    let residual = |u: Complex64, terms: &[(Complex64, f64)]| {
+        let y = u - terms.iter().map(|(z, _)| z).sum::<Complex64>();
+        let var = terms
+            .iter()
+            .map(|(z, t)| 0.5 * (t * z.norm()).powi(2))
+            .sum();
+        (y, var)
+    };
+    let (yd, vd) = residual(u_d, &d_terms);
+    let (yq, vq) = residual(u_q, &q_terms);
+    Some(([yd, yq], [vd, vq]))
+}
+
+/// The q and d back-EMF lines of window `w` at its 6·p_n order `o` from the logged
+/// voltages read with the stator constants `s` (`candidates` kept out of the noise
+/// floors); `None` for a window without the voltages, a speed or a floor.
+pub fn voltage_lines(
+    w: &WindowLines,
+    o: &OrderLines,
+    rig: &Rig,
+    s: &Stator,
+    candidates: &[u32],
+) -> Option<[LineObservation; 2]> {
+    let emf_per_unit = s.psi_f_wb * rig.motor.pole_pairs as f64 * w.window.speed_rad_s;
+    if emf_per_unit == 0.0 {
+        return None;
+    }
+    let ([yd, yq], [vd, vq]) = voltage_residuals(w, o, rig, s)?;
+    let floor = |axis: usize| {
+        w.floor(o.order, candidates, |x| {
+            voltage_residuals(w, x, rig, s).map_or(Complex64::default(), |(y, _)| y[axis])
+        })
+    };
+    let (floor_d, floor_q) = (floor(0), floor(1));
+    if !(floor_q.is_finite() && floor_d.is_finite()) {
+        return None;
+    }
+    Some([
+        LineObservation {
+            line: yq,
+            regressor: Complex64::new(-emf_per_unit, 0.0),
+            var: floor_q + vq,
+        },
+        LineObservation {
+            line: yd,
+            regressor: Complex64::new(emf_per_unit, 0.0),
+            var: floor_d + vd,
+        },
+    ])
 }
 
 /// The q current's closed-loop response to its reference on `rig` at angular frequency
@@ -186,6 +296,112 @@ mod tests {
                 assert!(ed.norm() < 0.01 * eq.norm(), "{ed} vs {eq}");
             }
         }
+    }
+
+    #[test]
+    fn the_voltage_lines_leave_the_back_emf_the_stator_equations_lack() {
+        // A shaft turning at 30 rad/s with a small oscillation at order 24, d and q currents
+        // with lines of their own, and the voltages of eq. 1–2 evaluated in time plus a
+        // back-EMF line E_q = −ψ_f·ω̄_e·a, E_d = ψ_f·ω̄_e·b: the residual lines are a and b.
+        use crate::diagnose::facts::SteadyWindow;
+        use std::f64::consts::PI;
+        let rig = Rig::nominal();
+        let m = &rig.motor;
+        let s = Stator {
+            r_s_ohm: m.r_s_ohm,
+            l_d_h: m.l_d_h,
+            l_q_h: m.l_q_h,
+            psi_f_wb: m.psi_f_wb,
+        };
+        let pp = m.pole_pairs as f64;
+        let (k, speed, eps) = (24u32, 30.0, 1e-3);
+        let kf = k as f64;
+        let (a, b) = (
+            Complex64::from_polar(0.05, 0.7),
+            Complex64::from_polar(0.02, -1.9),
+        );
+        let w_e = pp * speed;
+        let (e_q, e_d) = (-s.psi_f_wb * w_e * a, s.psi_f_wb * w_e * b);
+        let line = |z: Complex64, th: f64| (z * Complex64::from_polar(1.0, kf * th)).re;
+        let (iq_line, id_line) = (
+            Complex64::from_polar(0.2, 0.5),
+            Complex64::from_polar(0.15, -1.0),
+        );
+        let revs = 20.0;
+        let n = 200_000;
+        let dt = revs * 2.0 * PI / speed / n as f64;
+        let theta = |t: f64| speed * t + eps * (kf * speed * t + 0.3).sin();
+        let rate = |t: f64| speed + eps * kf * speed * (kf * speed * t + 0.3).cos();
+        let (iq, id) = (
+            |t: f64| 3.0 + line(iq_line, theta(t)),
+            |t: f64| 0.1 + line(id_line, theta(t)),
+        );
+        let deriv = |f: &dyn Fn(f64) -> f64, t: f64| (f(t + 1e-7) - f(t - 1e-7)) / 2e-7;
+        // Lines against e^{jkθ} by projection over whole revolutions, at k and neighbours,
+        // of the signals less their means (as the lock-in fits a mean beside the lines).
+        let samples: Vec<(f64, [f64; 5])> = (0..n)
+            .map(|i| {
+                let t = i as f64 * dt;
+                let th = theta(t);
+                let we = pp * rate(t);
+                let u_q = s.r_s_ohm * iq(t)
+                    + s.l_q_h * deriv(&iq, t)
+                    + we * (s.l_d_h * id(t) + s.psi_f_wb)
+                    + line(e_q, th);
+                let u_d = s.r_s_ohm * id(t) + s.l_d_h * deriv(&id, t) - we * s.l_q_h * iq(t)
+                    + line(e_d, th);
+                (th, [iq(t), id(t), th - speed * t, u_d, u_q])
+            })
+            .collect();
+        let mut mean = [0.0; 5];
+        for (_, y) in &samples {
+            for (m, v) in mean.iter_mut().zip(y) {
+                *m += v / n as f64;
+            }
+        }
+        let mut acc = vec![[Complex64::default(); 5]; 9];
+        for (th, y) in &samples {
+            for (j, o) in (k - 4..=k + 4).enumerate() {
+                let basis = Complex64::from_polar(2.0 / n as f64, -(o as f64) * th);
+                for ((z, v), m) in acc[j].iter_mut().zip(y).zip(&mean) {
+                    *z += basis * (v - m);
+                }
+            }
+        }
+        let orders: Vec<OrderLines> = (k - 4..=k + 4)
+            .zip(&acc)
+            .map(|(order, z)| OrderLines {
+                order,
+                iq: z[0],
+                id: z[1],
+                theta: z[2],
+                p: Complex64::default(),
+                torque: Complex64::default(),
+                voltages: Some([z[3], z[4]]),
+            })
+            .collect();
+        let w = WindowLines {
+            window: SteadyWindow {
+                rows: 0..n,
+                speed_rad_s: speed,
+                revolutions: revs,
+            },
+            iq_mean_a: 3.0,
+            id_mean_a: 0.1,
+            dp_mean_pa: 0.0,
+            orders: orders.clone(),
+        };
+        let [q, d] = voltage_lines(&w, &orders[4], &rig, &s, &[k]).unwrap();
+        // The shaft's oscillation alone makes a q-voltage line p_n·ψ_f·jw·Θ this large:
+        let swing = pp * s.psi_f_wb * kf * speed * eps;
+        assert!(
+            swing > 0.3 * (q.regressor * a).norm(),
+            "the oscillation matters: {swing}"
+        );
+        let fitted_a = q.line / q.regressor;
+        let fitted_b = d.line / d.regressor;
+        assert!((fitted_a - a).norm() < 0.02 * a.norm(), "{fitted_a} vs {a}");
+        assert!((fitted_b - b).norm() < 0.02 * b.norm(), "{fitted_b} vs {b}");
     }
 
     #[test]

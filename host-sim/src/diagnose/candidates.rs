@@ -328,11 +328,7 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
             ),
         ),
     };
-    let with_emf = if f.back_emf {
-        " with its back-EMF's d- and q-current lines"
-    } else {
-        ""
-    };
+    let with_emf = f.emf.describe();
     let evidence = format!(
         "unexplained torque line at order {order}{with_emf} over {} steady window(s){}: {what}; \
          Λ = {:.1} ({} degrees of freedom)",

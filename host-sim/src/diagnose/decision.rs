@@ -18,9 +18,8 @@
 //!    −[`VALIDATION_TOLERANCE`]): an effect the validation segment excites must improve it
 //!    or be refuted; one it does not excite (a bulk modulus seen only in a fill below the
 //!    precharge) cannot be confirmed there and stands on its identification evidence.
-//! 4. **No structural veto.** A dead time read from the current lines and the flux
-//!    harmonics share the lines at order 6·p_n: only the one that explains them better is
-//!    named ([`apply_vetoes`]).
+//! 4. **No structural veto.** A dead time and the flux harmonics share the lines at order
+//!    6·p_n: only the one that explains them better is named ([`apply_vetoes`]).
 //!
 //! Among the effects that qualify the one with the largest Λ is named; `none` otherwise.
 
@@ -62,38 +61,38 @@ pub fn why_not(t: &Tested) -> Option<String> {
     t.veto.clone()
 }
 
-/// Applies the structural vetoes across `tested`: the dead time read from the current
-/// lines and the flux harmonics share the lines at order 6·p_n, and only one of them is
-/// named.
+/// Applies the structural vetoes across `tested`: an inverter dead time and the flux
+/// harmonics share the lines at order 6·p_n, and only one of them is named.
 ///
-/// With the angle logged both are fitted to those lines (the flux harmonics with their
-/// back-EMF, [`crate::diagnose::back_emf`]), and the one standing further above its own
-/// significance threshold (Λ less the χ² quantile of its degrees of freedom: the flux
-/// harmonics' free d-axis amplitude costs them two more) explains them; the other is
-/// vetoed. Without the angle the flux harmonics have only the torque line's magnitudes, and
-/// a significant one vetoes the dead time (a dead time moves current and shaft together
-/// and leaves no torque).
+/// With the angle logged both are fitted to those lines: without voltages the dead time
+/// from the current lines and the flux harmonics with their back-EMF's current lines; with
+/// the voltages the dead time by the electrical relation and the flux harmonics with their
+/// back-EMF in the voltage lines ([`crate::diagnose::back_emf`]). The one standing further
+/// above its own significance threshold (Λ less the χ² quantile of its degrees of freedom:
+/// the flux harmonics' free d-axis amplitude costs them two more) explains them; the other
+/// is vetoed. Without the angle the flux harmonics have only the torque line's magnitudes,
+/// and a significant one vetoes the dead time (a dead time moves current and shaft
+/// together and leaves no torque).
 pub fn apply_vetoes(tested: &mut [Tested]) {
+    use crate::diagnose::angle_locked::EmfLines;
     use crate::diagnose::candidates::Extension;
     let flux = tested.iter().position(|t| t.effect == "flux_harmonics");
-    let dead = tested
-        .iter()
-        .position(|t| t.effect == "dead_time" && matches!(t.extension, Extension::CurrentLines(_)));
+    let dead = tested.iter().position(|t| t.effect == "dead_time");
     let (Some(f), Some(d)) = (flux, dead) else {
         return;
     };
     let margin = |t: &Tested| t.lambda - threshold(t.dof);
     let (mf, md) = (margin(&tested[f]), margin(&tested[d]));
-    let joint = matches!(&tested[f].extension, Extension::TorqueLine(l) if l.back_emf);
+    let joint = matches!(&tested[f].extension, Extension::TorqueLine(l) if l.emf != EmfLines::None);
     if joint && mf > 0.0 && mf >= md {
         tested[d].veto = Some(format!(
-            "the flux harmonics explain the current lines at 6·p_n better (Λ − threshold \
-             {mf:.1} against {md:.1})"
+            "the flux harmonics explain the lines at 6·p_n better (Λ − threshold {mf:.1} \
+             against {md:.1})"
         ));
     } else if joint && md > 0.0 && md > mf {
         tested[f].veto = Some(format!(
-            "an inverter dead time explains the current lines at 6·p_n better (Λ − threshold \
-             {md:.1} against {mf:.1})"
+            "an inverter dead time explains the lines at 6·p_n better (Λ − threshold {md:.1} \
+             against {mf:.1})"
         ));
     } else if !joint && mf > 0.0 {
         tested[d].veto = Some(

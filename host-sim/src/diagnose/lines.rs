@@ -31,6 +31,8 @@ pub struct WindowLines {
     pub window: SteadyWindow,
     /// Mean q current. [A]
     pub iq_mean_a: f64,
+    /// Mean d current. [A]
+    pub id_mean_a: f64,
     /// Mean pressure difference across the pump. [Pa]
     pub dp_mean_pa: f64,
     /// Per analysed order: the lines.
@@ -52,6 +54,8 @@ pub struct OrderLines {
     pub p: Complex64,
     /// Unexplained torque T_k. [N·m]
     pub torque: Complex64,
+    /// Commanded d and q voltages, when logged. [V]
+    pub voltages: Option<[Complex64; 2]>,
 }
 
 impl WindowLines {
@@ -185,13 +189,12 @@ pub fn window_lines(
                 }
                 v
             };
-            let z = lock_in(
-                t,
-                theta,
-                rows.clone(),
-                &orders,
-                &[&log.iq_a, &log.id_a, &trend, &log.p_pa],
-            )?;
+            let mut signals: Vec<&[f64]> = vec![&log.iq_a, &log.id_a, &trend, &log.p_pa];
+            let voltages = log.ud_v.as_deref().zip(log.uq_v.as_deref());
+            if let Some((ud, uq)) = voltages {
+                signals.extend([ud, uq]);
+            }
+            let z = lock_in(t, theta, rows.clone(), &orders, &signals)?;
             let lines = orders
                 .iter()
                 .enumerate()
@@ -205,6 +208,7 @@ pub fn window_lines(
                         theta: th,
                         p,
                         torque: iq * kt + th * (j * wk * wk) - p * d_per_rad,
+                        voltages: voltages.map(|_| [z[4][m], z[5][m]]),
                     }
                 })
                 .collect();
@@ -212,6 +216,7 @@ pub fn window_lines(
             Some(WindowLines {
                 window: w.clone(),
                 iq_mean_a: mean(&log.iq_a),
+                id_mean_a: mean(&log.id_a),
                 dp_mean_pa: mean(&log.p_pa) - mean(&facts.p_low_pa),
                 orders: lines,
             })
