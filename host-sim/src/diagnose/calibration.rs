@@ -35,7 +35,7 @@ use std::ops::Range;
 
 pub use crate::diagnose::hydraulic_relation::{
     hyd, hydraulic_params, hydraulic_residuals, hydraulic_specs, HydraulicRelation,
-    HYDRAULIC_WINDOW_S, LAG_BAND_S,
+    HYDRAULIC_WINDOW_S, LAG_BAND_S, SENSOR_OFFSET_BAND_PA,
 };
 pub use crate::diagnose::mechanical_relation::{
     mech, mechanical_params, mechanical_specs, MechanicalRelation, MECHANICAL_SMOOTHING_ROWS,
