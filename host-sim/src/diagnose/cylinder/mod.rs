@@ -9,11 +9,11 @@
 //! ```
 //!
 //! solved for the logged port pressure p (the plant's [`Cylinder::drive_force`] gives
-//! everything but the inertia and the friction), o the port transducer's zero. Velocity and acceleration of a sliding row are central
-//! differences of the logged position over ±[`RATE_HALF_WIDTH`] rows; the rows where the
-//! piston rests and its breakaways are read from the position by [`Stick`] (a
-//! backward-looking band at the transducer's resolution, so the last resting row before a
-//! breakaway keeps its full force).
+//! everything but the inertia and the friction), o the port transducer's zero. Velocity
+//! and acceleration of a sliding row are central differences of the logged position over
+//! ±[`RATE_HALF_WIDTH`] rows; the rows where the piston rests and its breakaways are read
+//! from the position by [`Stick`] (a backward-looking band at the transducer's resolution,
+//! so the last resting row before a breakaway keeps its full force).
 //!
 //! - A sliding row predicts p from the Coulomb force: cylinder friction beyond the rig
 //!   file shows as a pressure step with the direction of motion.
