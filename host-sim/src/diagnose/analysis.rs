@@ -16,11 +16,11 @@
 use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
 use super::back_emf::Stator;
 use super::calibration::{
-    calibrate, mech, thinned, Calibration, HydraulicRelation, MechanicalRelation, Patient, Release,
-    HYDRAULIC_WINDOW_S,
+    calibrate, mech, test_release_at_nominal, thinned, Calibration, HydraulicRelation,
+    MechanicalRelation, Patient, Release, HYDRAULIC_WINDOW_S,
 };
-use super::candidates::{test_lines, test_relation, Extension, Tested};
-use super::cylinder::CylinderRelation;
+use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
+use super::cylinder::{self, CylinderRelation};
 use super::decision::{apply_vetoes, decide};
 use super::diagnosis::Diagnosis;
 use super::electrical::ElectricalRelation;
@@ -289,10 +289,24 @@ fn test_relations(
                     reported(progress, t, "testing effects")
                 },
                 || {
-                    let rel = [Release::CylinderFriction];
                     let t = match (&r.cylinder, &cal.cylinder) {
                         (Some(y), Some(c)) => {
-                            test_relation(&r.patient(y), c, &r.m_id, &r.m_val, &rel, rig)
+                            let y = r.patient(y);
+                            // Along a one-way stroke the transducer's zero is the Coulomb
+                            // force's pressure step: the friction at the rig file's zero.
+                            let (t, at_zero) = test_release_at_nominal(
+                                &y,
+                                &r.m_id,
+                                Release::CylinderFriction,
+                                c,
+                                cylinder::ix::ZERO,
+                                y.relation.strokes_both_ways(),
+                            );
+                            let mut tested = from_release(&y, &t, &r.m_val, rig);
+                            if at_zero {
+                                tested.evidence.push_str(&y.relation.zero_caveat());
+                            }
+                            vec![tested]
                         }
                         _ => Vec::new(),
                     };

@@ -12,7 +12,8 @@
 //! | absorber shell V_0, precharge p_0 | ±5 % | listed ±2 % |
 //! | absorber inlet resistance R | ÷10 … ×30 | not listed (inlet, hose and bladder) |
 //! | leakage G (pump and cylinder) | ±20 % | coefficients listed; the path (eq. 9 or 10) not |
-//! | transducer gain, offset, lag | ±1 %, ±30 kPa, 0–2.5 ms | a calibrated transducer behind a snubber and an anti-aliasing filter |
+//! | transducer gain, offset (zero), lag | ±1 %, ±30 kPa ([`SENSOR_OFFSET_BAND_PA`]), 0–2.5 ms | a calibrated transducer behind a snubber and an anti-aliasing filter; the zero in the cylinder relation too |
+//! | cylinder Coulomb and breakaway force | 0 … 3× the rig file's | seals wear in and out ([`super::cylinder`]) |
 //! | magnet flux ψ_f (K_t) | ±5 % | listed ±2 %; magnet temperature |
 //! | inertia J | ±10 % | assumed in the rig contract |
 //! | viscous friction B | ÷2 … ×2 | assumed in the rig contract |
@@ -35,7 +36,7 @@ use std::ops::Range;
 
 pub use crate::diagnose::hydraulic_relation::{
     hyd, hydraulic_params, hydraulic_residuals, hydraulic_specs, HydraulicRelation,
-    HYDRAULIC_WINDOW_S, LAG_BAND_S,
+    HYDRAULIC_WINDOW_S, LAG_BAND_S, SENSOR_OFFSET_BAND_PA,
 };
 pub use crate::diagnose::mechanical_relation::{
     mech, mechanical_params, mechanical_specs, MechanicalRelation, MECHANICAL_SMOOTHING_ROWS,
@@ -150,6 +151,38 @@ impl<R: Relation> Relation for Patient<'_, R> {
     }
     fn patience(&self) -> usize {
         self.patience
+    }
+}
+
+/// A relation with parameter `index` held at `value`: the best fit of the others there
+/// (a profile of the relation's objective).
+pub struct Pinned<'r, R> {
+    /// The relation.
+    pub relation: &'r R,
+    /// Index of the held parameter in the search vector.
+    pub index: usize,
+    /// Its value. [unit of the parameter]
+    pub value: f64,
+}
+
+impl<R: Relation> Relation for Pinned<'_, R> {
+    fn specs(&self, release: Release) -> Vec<ParamSpec> {
+        let mut specs = self.relation.specs(release);
+        if let Some(s) = specs.get_mut(self.index) {
+            let u = s.coordinate(self.value);
+            s.u_bounds = (u, u);
+            s.start = u;
+        }
+        specs
+    }
+    fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
+        self.relation.residuals(values, rows)
+    }
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        self.relation.released(release)
+    }
+    fn patience(&self) -> usize {
+        self.relation.patience()
     }
 }
 
@@ -332,4 +365,60 @@ pub fn weighed_sse<R: Relation>(
         .map(|r| r * r)
         .sum::<f64>()
         / scale.max(f64::MIN_POSITIVE)
+}
+
+/// How much worse a released fit may get with a tolerance held at the rig file's value
+/// before the log is said to reject that value: the χ²(1) quantile at 95 %. [1]
+pub const NOMINAL_REJECTION: f64 = 3.84;
+
+/// `release` tested on `relation` over `rows` from the calibration `base` ([`test_release`]),
+/// its effect read at parameter `index`'s rig-file value (a tolerance, within its band in
+/// every fit) unless the log tells that value apart and rejects it.
+///
+/// Where the log leaves a direction flat — a tolerance that shows as the released effect
+/// does, such as the transducer's zero and the cylinder's Coulomb force along a one-way
+/// stroke — the free released fit may stop anywhere along it (or where the model's own
+/// approximations push it): the effect is reported as it is with the tolerance at the rig
+/// file's value, the same test run with the tolerance held there. `separable` says whether
+/// the log can tell the tolerance from the effect at all; if it can, the free fit is
+/// reported when the held one is worse by more than [`NOMINAL_REJECTION`] (a profile
+/// likelihood ratio). Λ, which decides whether the effect is named, is measured against
+/// the free baseline (the tolerance anywhere in its band): the effect must explain more
+/// than any value within the band can. Also returns whether the effect is read at the rig
+/// file's value.
+pub fn test_release_at_nominal<R: Relation>(
+    relation: &R,
+    rows: &[Range<usize>],
+    release: Release,
+    base: &Calibration,
+    index: usize,
+    separable: bool,
+) -> (ReleaseTest, bool) {
+    let free = test_release(relation, rows, release, base);
+    let Some(nominal) = relation
+        .specs(Release::Nothing)
+        .get(index)
+        .map(|s| s.nominal)
+    else {
+        return (free, false);
+    };
+    let pinned = Pinned {
+        relation,
+        index,
+        value: nominal,
+    };
+    let held = test_release(&pinned, rows, release, base);
+    let j = |v: &[f64]| weighed_sse(relation, v, rows, free.scale);
+    let (j_free, j_held) = (j(&free.fitted.values), j(&held.fitted.values));
+    if separable && j_held - j_free > NOMINAL_REJECTION {
+        return (free, false);
+    }
+    // The held fit is a point of the released search space too.
+    let lambda = free.lambda + (j_free - j_held).max(0.0);
+    let test = ReleaseTest {
+        fitted: held.fitted,
+        lambda,
+        ..free
+    };
+    (test, true)
 }

@@ -8,7 +8,7 @@
 //! | `accumulator_precharge` | hydraulic relation, precharge released | p_0 ±5 % |
 //! | `pressure_sensor_lag` | hydraulic relation, lag released | 0–2.5 ms |
 //! | `shaft_friction` | mechanical relation, Coulomb torque released | 0–0.02 N·m |
-//! | `cylinder_friction` | cylinder relation, Coulomb and breakaway force released together (the breakaway where the piston rests) | each 0–3× the rig's |
+//! | `cylinder_friction` | cylinder relation, Coulomb and breakaway force released together (the breakaway where the piston rests), read at the rig file's transducer zero unless a reversal tells the zero apart | each 0–3× the rig's, with the transducer zero ±30 kPa |
 //! | `dead_time` | electrical relation (voltages logged), else the d/q current lines at 6·p_n | 0–0.1 µs |
 //! | `cogging_torque` | torque line at the slot order | 0.01 N·m |
 //! | `flux_harmonics` | torque line at 6·p_n ∝ mean torque, and (angle logged) its back-EMF's current lines | 0.5 % |

@@ -16,6 +16,12 @@ use std::ops::Range;
 /// the logger's anti-aliasing filter. [s]
 pub const LAG_BAND_S: f64 = 2.5e-3;
 
+/// Half-width of the pressure transducer's zero (offset) tolerance band about the rig
+/// file's: a calibrated transducer's zero after mounting and warm-up. Every relation that
+/// reads the logged port pressure carries it (the hydraulic and the cylinder relations).
+/// [Pa]
+pub const SENSOR_OFFSET_BAND_PA: f64 = 30e3;
+
 /// Length of a hydraulic shooting window. [s]
 pub const HYDRAULIC_WINDOW_S: f64 = 0.25;
 
@@ -111,8 +117,10 @@ pub fn hydraulic_specs(rig: &Rig, release: Release) -> Vec<ParamSpec> {
                 .with_band(0.8 * n.leakage_m3_s_pa, 1.2 * n.leakage_m3_s_pa)
         },
         ParamSpec::linear("sensor_gain", 1.0, 0.01, 0.8, 1.2).with_band(0.99, 1.01),
-        ParamSpec::linear("sensor_offset_pa", n.sensor_offset_pa, 1e4, -1e6, 1e6)
-            .with_band(n.sensor_offset_pa - 3e4, n.sensor_offset_pa + 3e4),
+        ParamSpec::linear("sensor_offset_pa", n.sensor_offset_pa, 1e4, -1e6, 1e6).with_band(
+            n.sensor_offset_pa - SENSOR_OFFSET_BAND_PA,
+            n.sensor_offset_pa + SENSOR_OFFSET_BAND_PA,
+        ),
         lag,
         ParamSpec::log(
             "displacement_m3_per_rev",

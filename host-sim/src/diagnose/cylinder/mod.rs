@@ -3,17 +3,17 @@
 //! Karnopp's model (`plant_model::friction`, as the plant has it),
 //!
 //! ```text
-//!   A·(p − p_low) = m·ẍ + B·ẋ + F_f + k·x + m·g·sin α − F_stop(x, ẋ)
+//!   A·(p − o − p_low) = m·ẍ + B·ẋ + F_f + k·x + m·g·sin α − F_stop(x, ẋ)
 //!   sliding:  F_f = F_c·sgn(ẋ)
 //!   resting:  F_f = whatever holds the piston, |F_f| ≤ F_s      (ẋ = ẍ = 0)
 //! ```
 //!
-//! solved for the port pressure (the plant's [`Cylinder::drive_force`] gives everything but
-//! the inertia and the friction). Velocity and acceleration of a sliding row are central
-//! differences of the logged position over ±[`RATE_HALF_WIDTH`] rows; the rows where the
-//! piston rests and its breakaways are read from the position by [`Stick`] (a
-//! backward-looking band at the transducer's resolution, so the last resting row before a
-//! breakaway keeps its full force).
+//! solved for the logged port pressure p (the plant's [`Cylinder::drive_force`] gives
+//! everything but the inertia and the friction), o the port transducer's zero. Velocity
+//! and acceleration of a sliding row are central differences of the logged position over
+//! ±[`RATE_HALF_WIDTH`] rows; the rows where the piston rests and its breakaways are read
+//! from the position by [`Stick`] (a backward-looking band at the transducer's resolution,
+//! so the last resting row before a breakaway keeps its full force).
 //!
 //! - A sliding row predicts p from the Coulomb force: cylinder friction beyond the rig
 //!   file shows as a pressure step with the direction of motion.
@@ -28,6 +28,22 @@
 //!   drives with the uniform distribution's spread (width/√12, and the two rows' pressure
 //!   noise): one more residual per breakaway. Without it the resting rows would leave
 //!   every F_s above the largest held force equally good.
+//!
+//! The transducer's zero o is a tolerance like the calibration's (the rig file's ±
+//! [`SENSOR_OFFSET_BAND_PA`], the band the hydraulic relation has): it shifts every row's
+//! balance, sliding rows and the resting rows' friction-free level p_0 alike, so a
+//! breakaway is read against it too. Without the low side logged it is one constant
+//! pressure shift with the unknown low side, and the one parameter [`ix::LOW_SIDE`] holds
+//! both. Along a one-way stroke the Coulomb force is the same constant pressure step as
+//! the zero (A·30 kPa ≈ 210 N on a 71 cm² piston): cylinder friction is then named only
+//! when it explains more than any zero within the band can, and its levels are read at the
+//! rig file's zero ([`crate::diagnose::calibration::test_release_at_nominal`]; the
+//! report says so and by how much the zero's band could move them). Only a reversal, where
+//! the Coulomb step changes sign and the zero does not, separates the two
+//! ([`CylinderRelation::strokes_both_ways`]); there the free fit is reported unless the
+//! rig file's zero fits as well. The hydraulic relation's fitted zero is no help: the
+//! pressure's volume balance depends on the zero only through the leakage and the
+//! absorber's gas law, which leave it to its band's edges on a free payload's logs.
 //!
 //! The breakaway F_s is a parameter of its own beside the Coulomb force F_c, and the
 //! model uses max(F_s, F_c) as the plant does (it raises a breakaway below the Coulomb level
@@ -45,8 +61,8 @@
 //! hold.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{Relation, Release};
-use crate::diagnose::facts::LogFacts;
+use crate::diagnose::calibration::{Relation, Release, SENSOR_OFFSET_BAND_PA};
+use crate::diagnose::facts::{LogFacts, MOVING_PISTON_TRAVEL_M};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use crate::diagnose::mechanical::central_rate;
 use crate::diagnose::stick::Stick;
@@ -70,7 +86,11 @@ pub mod ix {
     pub const COULOMB: usize = 2;
     /// Breakaway (static) friction (the Coulomb friction where below it).
     pub const BREAKAWAY: usize = 3;
-    /// Low-side pressure, when it is not logged.
+    /// The port pressure transducer's zero (offset), when the low side is logged.
+    pub const ZERO: usize = 4;
+    /// The low side's pressure as the port transducer reads it (its zero included), when
+    /// the low side is not logged: the zero and the low side are then one constant
+    /// pressure shift, and one parameter.
     pub const LOW_SIDE: usize = 4;
 }
 
@@ -138,6 +158,47 @@ impl<'a> CylinderRelation<'a> {
             .any(|r| *r)
     }
 
+    /// Whether the piston travels both ways in the identification segment, by more than
+    /// [`MOVING_PISTON_TRAVEL_M`] each: only a reversal, where the Coulomb force's
+    /// pressure step changes sign and the transducer's zero does not, tells them apart.
+    /// Along a one-way stroke they differ only where the piston starts and stops, in the
+    /// Coulomb force's fade and the stick phase, which the model approximates.
+    pub fn strokes_both_ways(&self) -> bool {
+        let x = &self.x[self.facts.identification()];
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut rise, mut fall) = (0.0f64, 0.0f64);
+        for &v in x {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            rise = rise.max(v - lo);
+            fall = fall.max(hi - v);
+        }
+        rise > MOVING_PISTON_TRAVEL_M && fall > MOVING_PISTON_TRAVEL_M
+    }
+
+    /// What reading the friction at the rig file's transducer zero means, in words: the
+    /// log did not tell the zero from the friction, so each level carries the zero's
+    /// tolerance on the piston.
+    pub fn zero_caveat(&self) -> String {
+        let (what, half_band) = match self.log.p_low_pa {
+            Some(_) => ("transducer zero", SENSOR_OFFSET_BAND_PA),
+            None => {
+                let (lo, hi) = LOW_SIDE_BAND_PA;
+                (
+                    "low-side pressure (not logged) with the transducer zero",
+                    0.5 * (hi - lo) + SENSOR_OFFSET_BAND_PA,
+                )
+            }
+        };
+        format!(
+            "; read at the rig file's {what}, which this log does not tell from the friction \
+             (the piston does not stroke both ways, or the fit is no worse there): its \
+             tolerance, ±{:.0} kPa, is ±{:.0} N on the piston",
+            half_band / 1e3,
+            half_band * self.rig.cylinder.area_m2
+        )
+    }
+
     /// The breakaway level the identification segment shows at the rig file's values: the
     /// mean of its breakaways' levels, else the largest force held at rest; `None` when the
     /// piston never rests there. [N]
@@ -146,7 +207,7 @@ impl<'a> CylinderRelation<'a> {
             return None;
         }
         let cyl = Cylinder::new(&self.rig.cylinder);
-        let low_side = self.log.p_low_pa.is_none().then(|| self.nominal_low_side());
+        let shift = self.nominal_shift();
         let ident = self.facts.identification();
         let levels: Vec<f64> = self
             .stick
@@ -154,7 +215,7 @@ impl<'a> CylinderRelation<'a> {
             .iter()
             .filter(|b| ident.contains(&b.row) && ident.contains(&(b.row + 1)))
             .map(|b| {
-                let held = |k| self.held_force(&cyl, low_side, k);
+                let held = |k| self.held_force(&cyl, shift, k);
                 b.dir * 0.5 * (held(b.row) + held(b.row + 1))
             })
             .collect();
@@ -163,44 +224,64 @@ impl<'a> CylinderRelation<'a> {
         }
         ident
             .filter(|k| self.stick.rests[*k])
-            .map(|k| self.held_force(&cyl, low_side, k).abs())
+            .map(|k| self.held_force(&cyl, shift, k).abs())
             .max_by(f64::total_cmp)
     }
 
-    /// The low side's pressure the search starts from when the log does not have it. [Pa]
-    fn nominal_low_side(&self) -> f64 {
-        let (lo, hi) = LOW_SIDE_BAND_PA;
-        self.rig.fill.pressure_pa.clamp(lo, hi)
+    /// The rig file's transducer zero. [Pa]
+    fn nominal_zero(&self) -> f64 {
+        self.rig.sensors.pressure.offset_pa
     }
 
-    /// The cylinder at `values` and its low-side pressure (`None`: logged).
-    fn cylinder_at(&self, values: &[f64]) -> (Cylinder, Option<f64>) {
+    /// The constant pressure shift the search starts from: the rig file's transducer zero
+    /// ([`ix::ZERO`]), or, the low side not logged, the rig file's fill pressure as the
+    /// port transducer reads it ([`ix::LOW_SIDE`]). [Pa]
+    fn nominal_shift(&self) -> f64 {
+        if self.log.p_low_pa.is_some() {
+            return self.nominal_zero();
+        }
+        let (lo, hi) = LOW_SIDE_BAND_PA;
+        self.rig.fill.pressure_pa.clamp(lo, hi) + self.nominal_zero()
+    }
+
+    /// The low side's pressure at row `k` as the port transducer reads it, with the
+    /// relation's pressure shift `shift` (the value of [`ix::ZERO`] or [`ix::LOW_SIDE`]):
+    /// the logged low side plus the port transducer's zero, or the shift itself. [Pa]
+    fn low_side(&self, shift: f64, k: usize) -> f64 {
+        match self.log.p_low_pa {
+            Some(_) => self.facts.p_low_pa[k] + shift,
+            None => shift,
+        }
+    }
+
+    /// The cylinder at `values` and its pressure shift ([`CylinderRelation::low_side`]).
+    fn cylinder_at(&self, values: &[f64]) -> (Cylinder, f64) {
         let mut c = self.rig.cylinder.clone();
         c.viscous_n_s_per_m = values[ix::VISCOUS];
         c.mass_kg = values[ix::MASS];
-        (Cylinder::new(&c), values.get(ix::LOW_SIDE).copied())
+        (Cylinder::new(&c), values[ix::ZERO])
     }
 
-    /// The net force on the piston at rest but friction at row `k`: what the friction
-    /// holds while it rests. [N]
-    fn held_force(&self, cyl: &Cylinder, low_side: Option<f64>, k: usize) -> f64 {
-        let p_low = low_side.unwrap_or(self.facts.p_low_pa[k]);
+    /// The net force on the piston at rest but friction at row `k` with the pressure shift
+    /// `shift`: what the friction holds while it rests. [N]
+    fn held_force(&self, cyl: &Cylinder, shift: f64, k: usize) -> f64 {
+        let p_low = self.low_side(shift, k);
         cyl.drive_force(self.log.p_pa[k], p_low, self.x[k], 0.0, 0.0)
     }
 
     /// The port pressure the balance predicts over `rows` at `values`, into `out`: at a
     /// resting row the measured one within the breakaway level's reach. [Pa]
     pub fn predict(&self, values: &[f64], rows: Range<usize>, out: &mut [f64]) {
-        let (cyl, low_side) = self.cylinder_at(values);
+        let (cyl, shift) = self.cylinder_at(values);
         let area = cyl.area_m2;
         let coulomb = values[ix::COULOMB];
         let breakaway = breakaway_level(values);
         for k in rows {
-            let p_low = low_side.unwrap_or(self.facts.p_low_pa[k]);
+            let p_low = self.low_side(shift, k);
             let p = self.log.p_pa[k];
             if self.stick.rests[k] {
                 // held = A·(p − p_low) − rest: the friction takes it up to ±F_s.
-                let held = self.held_force(&cyl, low_side, k);
+                let held = self.held_force(&cyl, shift, k);
                 out[k] = p - (held - held.clamp(-breakaway, breakaway)) / area;
                 continue;
             }
@@ -220,7 +301,7 @@ impl<'a> CylinderRelation<'a> {
         rows: &[Range<usize>],
         sigma: f64,
     ) -> Vec<f64> {
-        let (cyl, low_side) = self.cylinder_at(values);
+        let (cyl, shift) = self.cylinder_at(values);
         let breakaway = breakaway_level(values);
         let noise_n = cyl.area_m2 * sigma;
         self.stick
@@ -231,8 +312,8 @@ impl<'a> CylinderRelation<'a> {
                     .any(|r| r.contains(&b.row) && r.contains(&(b.row + 1)))
             })
             .map(|b| {
-                let before = b.dir * self.held_force(&cyl, low_side, b.row);
-                let after = b.dir * self.held_force(&cyl, low_side, b.row + 1);
+                let before = b.dir * self.held_force(&cyl, shift, b.row);
+                let after = b.dir * self.held_force(&cyl, shift, b.row + 1);
                 let spread = ((after - before).powi(2) / 12.0 + 0.5 * noise_n * noise_n).sqrt();
                 (0.5 * (before + after) - breakaway) / spread.max(f64::MIN_POSITIVE)
             })
@@ -278,11 +359,19 @@ impl Relation for CylinderRelation<'_> {
             coulomb,
             breakaway,
         ];
-        if self.log.p_low_pa.is_none() {
-            let (lo, hi) = LOW_SIDE_BAND_PA;
-            let fill = self.nominal_low_side();
-            specs.push(ParamSpec::linear("low_side_pa", fill, 1e4, 0.0, 5e6).with_band(lo, hi));
-        }
+        // The transducer's zero shifts the whole balance, sliding and resting rows alike;
+        // without the low side logged it is part of the low side's band.
+        let (zero, z) = (self.nominal_zero(), SENSOR_OFFSET_BAND_PA);
+        let shift = self.nominal_shift();
+        specs.push(match self.log.p_low_pa {
+            Some(_) => ParamSpec::linear("sensor_offset_pa", shift, 1e4, -1e6, 1e6)
+                .with_band(zero - z, zero + z),
+            None => {
+                let (lo, hi) = LOW_SIDE_BAND_PA;
+                ParamSpec::linear("low_side_pa", shift, 1e4, -1e6, 6e6)
+                    .with_band(lo + zero - z, hi + zero + z)
+            }
+        });
         specs
     }
 
@@ -320,138 +409,4 @@ impl Relation for CylinderRelation<'_> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::diagnose::calibration::{calibrate, fit_relation, test_release};
-    use crate::diagnose::test_noise::gaussian;
-
-    /// Rig file's cylinder (nominal: A = 71 cm², m = 2000 kg, B = 150 N·s/m, no spring,
-    /// level) with these friction levels in the plant that made the log. [N]
-    const COULOMB_N: f64 = 400.0;
-    const BREAKAWAY_N: f64 = 650.0;
-    const P_LOW_PA: f64 = 0.5e6;
-    /// White noise on the logged port pressure, a transducer's. [Pa]
-    const NOISE_PA: f64 = 300.0;
-    /// How close the fitted breakaway must come (see the test). [N]
-    const BREAKAWAY_TOLERANCE_N: f64 = 0.5 + 3.0 * 1.5;
-
-    /// Time constant of the piston's speed after the breakaway. [s]
-    const TAU_S: f64 = 0.1;
-
-    /// A hand-built log of Karnopp's model at 1 kHz: the piston rests at 2 mm while the
-    /// force on it ramps at 1 N per row from −0.4 N, so it reaches F_s at 650.4 ms
-    /// (between rows 650 and 651); from then on the friction drops to F_c and the piston
-    /// speeds up as v = v_f·(1 − e^(−s/τ)), s = t − t_b, its acceleration at the breakaway
-    /// (F_s − F_c)/m, the force following the balance m·a + B·v + F_c exactly. The pressure
-    /// is logged with [`NOISE_PA`] of white noise.
-    fn breakaway_log() -> BenchLog {
-        let rig = Rig::nominal();
-        let c = &rig.cylinder;
-        let (area, m, b) = (c.area_m2, c.mass_kg, c.viscous_n_s_per_m);
-        let t_b = (BREAKAWAY_N + 0.4) / 1000.0;
-        let v_f = (BREAKAWAY_N - COULOMB_N) / m * TAU_S;
-        let n = 1000;
-        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
-        let (x, force): (Vec<f64>, Vec<f64>) = t
-            .iter()
-            .map(|&t| {
-                if t < t_b {
-                    (2e-3, -0.4 + 1000.0 * t)
-                } else {
-                    let e = (-(t - t_b) / TAU_S).exp();
-                    let (v, a) = (v_f * (1.0 - e), v_f / TAU_S * e);
-                    let x = 2e-3 + v_f * (t - t_b - TAU_S * (1.0 - e));
-                    (x, m * a + b * v + COULOMB_N)
-                }
-            })
-            .unzip();
-        BenchLog {
-            t_s: t,
-            p_ref_pa: vec![P_LOW_PA; n],
-            p_pa: force
-                .iter()
-                .zip(gaussian(n, 17))
-                .map(|(f, e)| P_LOW_PA + f / area + NOISE_PA * e)
-                .collect(),
-            speed_rad_s: vec![0.0; n],
-            iq_a: vec![0.0; n],
-            id_a: vec![0.0; n],
-            x_m: Some(x),
-            p_low_pa: Some(vec![P_LOW_PA; n]),
-            ..BenchLog::default()
-        }
-    }
-
-    #[test]
-    fn a_resting_piston_holds_up_to_the_breakaway_level_and_the_fit_finds_it() {
-        let rig = Rig::nominal();
-        let log = breakaway_log();
-        let facts = LogFacts::of(&log, &rig);
-        let rel = CylinderRelation::of(&log, &facts, &rig).expect("the piston moves");
-        assert_eq!(rel.stick().breakaways.len(), 1);
-        assert_eq!(rel.stick().breakaways[0].row, 650);
-        let area = rig.cylinder.area_m2;
-
-        // At rest the friction takes up the drive up to F_s: with F_s = 300 N a row whose
-        // drive is 499.6 N is predicted at the breakaway level's pressure, 300 N/A over
-        // p_low; one with 199.6 N at its measured pressure.
-        let mut v = vec![2000.0, 150.0, 100.0, 300.0];
-        let mut out = vec![0.0; log.len()];
-        rel.predict(&v, 200..601, &mut out);
-        assert!(
-            (out[500] - (P_LOW_PA + 300.0 / area)).abs() < 1e-6,
-            "{}",
-            out[500]
-        );
-        assert!((out[200] - log.p_pa[200]).abs() < 1e-6, "{}", out[200]);
-
-        // The calibrated baseline, then both friction levels released: the breakaway comes
-        // out within the half row (0.5 N) its crossing is known to and three standard
-        // deviations of the two rows' mean pressure noise (A·σ/√2 = 1.5 N), the Coulomb
-        // force within the percent the central differences' smearing of the kink allows.
-        // The whole log after the start skip, in the calibration's one-second windows.
-        let rows = facts.windows(facts.identification().start..log.len(), 1.0);
-        let t = test_release(
-            &rel,
-            &rows,
-            Release::CylinderFriction,
-            &calibrate(&rel, &rows),
-        );
-        let f = &t.fitted.values;
-        let breakaway = breakaway_level(f);
-        assert!(
-            (breakaway - BREAKAWAY_N).abs() < BREAKAWAY_TOLERANCE_N,
-            "{f:?}"
-        );
-        assert!(
-            (f[ix::COULOMB] - COULOMB_N).abs() < 0.01 * COULOMB_N,
-            "{f:?}"
-        );
-
-        // Started far above, the fit comes back down: the breakaway bounds F_s from above
-        // where the resting rows leave it flat.
-        v[ix::COULOMB] = COULOMB_N;
-        v[ix::BREAKAWAY] = 3000.0;
-        let high = fit_relation(&rel, &rows, Release::CylinderFriction, 1.0, Some(&v));
-        let breakaway = breakaway_level(&high.values);
-        assert!(
-            (breakaway - BREAKAWAY_N).abs() < BREAKAWAY_TOLERANCE_N,
-            "{:?}",
-            high.values
-        );
-    }
-
-    #[test]
-    fn a_log_that_never_shows_the_piston_resting_keeps_the_breakaway_in_its_band() {
-        // The same log from 10 ms after the breakaway: the piston slides throughout, the
-        // breakaway level is not in it, and cylinder friction releases the Coulomb force
-        // alone.
-        let rig = Rig::nominal();
-        let log = breakaway_log().tail(661);
-        let facts = LogFacts::of(&log, &rig);
-        let rel = CylinderRelation::of(&log, &facts, &rig).expect("the piston moves");
-        assert!(!rel.sees_rest());
-        let specs = rel.specs(Release::CylinderFriction);
-        assert!(specs[ix::BREAKAWAY].band.is_some() && specs[ix::COULOMB].band.is_none());
-    }
-}
+mod tests;
