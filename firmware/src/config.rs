@@ -243,7 +243,7 @@ pub struct Config {
     pub limits: FaultLimits,
     /// Calibration.
     pub calibration: CalibrationConfig,
-    /// Commissioning sequence (motor identification, issue 8).
+    /// Commissioning sequence (motor identification).
     pub commissioning: CommissioningConfig,
     /// Angle-indexed torque feed-forward ([`crate::compensation`]).
     pub compensation: CompensationConfig,

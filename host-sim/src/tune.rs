@@ -1,4 +1,4 @@
-//! `eha tune` (issue 8): from a bench log holding a setpoint step of one loop, identify that
+//! `eha tune`: from a bench log holding a setpoint step of one loop, identify that
 //! loop's plant, propose gains meeting an overshoot/settling target, predict the step with
 //! them on the identified plant, and print the CAN commands that apply them.
 //!

@@ -1,4 +1,4 @@
-//! `eha tune` (issue 8) on logs of a controller that believes the wrong plant: an absorber
+//! `eha tune` on logs of a controller that believes the wrong plant: an absorber
 //! precharged to 10 MPa where the pressure loop's schedule assumes 3 MPa, and a shaft of
 //! three times the inertia the speed loop was designed for. The old gains miss the target
 //! in the log; the proposed ones, replayed on the *true* plant (not the identified model),

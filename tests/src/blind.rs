@@ -1,4 +1,4 @@
-//! The generator of the blind identification suite (issue 5): from a seed the diagnosis never
+//! The generator of the blind identification suite: from a seed the diagnosis never
 //! sees, it draws one effect of the catalogue (`shared/contracts/effects.md`) or none, its
 //! parameters from realistic ranges, a rig whose other parameters deviate by their
 //! tolerances from the nominal one, the sensor noise, and a scenario that excites the

@@ -1,4 +1,4 @@
-//! The blind identification suite (issue 5): over [`SUITE_SEEDS`] seeds and the mended
+//! The blind identification suite: over [`SUITE_SEEDS`] seeds and the mended
 //! [`tests::blind::REGRESSION_SEEDS`] the generator ([`tests::blind`]) hides one
 //! catalogue effect or none in a closed-loop bench log of a
 //! tolerance-perturbed rig; the diagnosis (`host_sim::diagnose::diagnose`) gets only the log

@@ -1,4 +1,4 @@
-//! Commissioning in closed loop (issue 8): the firmware's sequence on the plant's motor,
+//! Commissioning in closed loop: the firmware's sequence on the plant's motor,
 //! from a drive that knows only the nameplate, with the sensors' noise and quantisation on.
 //!
 //! - 20 seeded rigs, R_s, L_d, L_q and ψ_f each scaled by a factor drawn in [0.7, 1.3] and

@@ -1,4 +1,4 @@
-//! Loop gains from the identified motor (issue 8).
+//! Loop gains from the identified motor.
 //!
 //! Current loops: pole–zero cancellation on the stator's R-L (Section 3.1, eq. 6, the
 //! design behind Table 1): Kp = L·ω_c, Ki = R_s·ω_c, so each closed current loop is the

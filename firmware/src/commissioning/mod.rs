@@ -1,4 +1,4 @@
-//! Commissioning (issue 8): identifies the motor the drive is connected to and derives the
+//! Commissioning: identifies the motor the drive is connected to and derives the
 //! loop gains, as a state machine the controller steps once per PWM period in mode
 //! Calibrating after the current offsets are measured.
 //!

@@ -1,4 +1,4 @@
-//! `eha commission` (issue 8): the firmware's commissioning sequence
+//! `eha commission`: the firmware's commissioning sequence
 //! ([`firmware::commissioning`]) in closed loop on the rig's simulated motor, with the
 //! sensors' noise and quantisation on, from a drive configured with the nameplate only
 //! ([`closed_loop::commissioning::nameplate_config`]). Prints identified vs true values,

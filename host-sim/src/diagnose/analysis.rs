@@ -14,7 +14,6 @@
 //!    order spectra of the baseline) and the contract's result.
 
 use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
-use super::back_emf::Stator;
 use super::calibration::{
     calibrate, mech, test_release_at_nominal, thinned, Calibration, HydraulicRelation,
     MechanicalRelation, Patient, Release, HYDRAULIC_WINDOW_S,
@@ -321,17 +320,6 @@ fn test_relations(
     tested
 }
 
-/// The stator constants of the electrical relation's search `values`.
-fn stator(values: &[f64]) -> Stator {
-    use super::electrical::ix;
-    Stator {
-        r_s_ohm: values[ix::R],
-        l_d_h: values[ix::LD],
-        l_q_h: values[ix::LQ],
-        psi_f_wb: values[ix::PSI],
-    }
-}
-
 /// Runs the whole diagnosis, reporting each finished step to `progress`.
 pub fn analyse_reporting(
     log: &BenchLog,
@@ -373,7 +361,7 @@ pub fn analyse_reporting(
         LineReading {
             coherent: facts.angle_logged,
             emf: match &cal.electrical {
-                Some(c) => EmfLines::Voltages(stator(&c.fitted.values)),
+                Some(c) => EmfLines::Voltages(super::electrical::stator(&c.fitted.values)),
                 None => EmfLines::Currents,
             },
         },

@@ -14,6 +14,7 @@
 //! differences of the logged currents.
 
 use crate::bench_log::{BenchLog, Signal};
+use crate::diagnose::back_emf::Stator;
 use crate::diagnose::calibration::{Relation, Release};
 use crate::diagnose::facts::LogFacts;
 use crate::diagnose::least_squares::{huber, ParamSpec};
@@ -38,6 +39,16 @@ pub mod ix {
     pub const PSI: usize = 3;
     /// Dead time.
     pub const DEAD_TIME: usize = 4;
+}
+
+/// The stator constants of the electrical relation's search `values`.
+pub fn stator(values: &[f64]) -> Stator {
+    Stator {
+        r_s_ohm: values[ix::R],
+        l_d_h: values[ix::LD],
+        l_q_h: values[ix::LQ],
+        psi_f_wb: values[ix::PSI],
+    }
 }
 
 /// The electrical relation of a log with `ud_v`, `uq_v` and the shaft angle.

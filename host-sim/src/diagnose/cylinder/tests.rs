@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::diagnose::calibration::{
-    calibrate, fit_relation, test_release, test_release_at_nominal, Pinned,
+    calibrate, fit_relation, test_release, test_release_at_nominal, Pinned, ReleaseTest,
 };
 use crate::diagnose::decision::threshold;
 use crate::diagnose::test_noise::gaussian;
@@ -202,33 +202,51 @@ fn one_way(t: f64) -> (f64, f64, f64) {
     (2e-3 * t, 2e-3, 0.0)
 }
 
+/// The sliding log of `motion` with Coulomb force `coulomb`, its relation and
+/// identification rows handed to `check`.
+fn on_sliding_log<T>(
+    motion: fn(f64) -> (f64, f64, f64),
+    coulomb: f64,
+    check: impl FnOnce(&Rig, &CylinderRelation, &[Range<usize>]) -> T,
+) -> T {
+    let rig = Rig::nominal();
+    let log = sliding_log(motion, coulomb);
+    let facts = LogFacts::of(&log, &rig);
+    let rel = CylinderRelation::of(&log, &facts, &rig).expect("the piston moves");
+    let rows = facts.windows(facts.identification(), 1.0);
+    check(&rig, &rel, &rows)
+}
+
+/// Cylinder friction released on `rel` over `rows`, read at the rig file's zero unless
+/// the stroke tells the zero apart.
+fn friction_at_rig_zero(rel: &CylinderRelation, rows: &[Range<usize>]) -> (ReleaseTest, bool) {
+    test_release_at_nominal(
+        rel,
+        rows,
+        Release::CylinderFriction,
+        &calibrate(rel, rows),
+        ix::ZERO,
+        rel.strokes_both_ways(),
+    )
+}
+
 #[test]
 fn a_stroke_both_ways_tells_the_transducer_zero_from_the_coulomb_force() {
     // The Coulomb step flips with the motion and the zero does not: the released fit
     // finds both, the friction within the percent the central differences' smearing of
     // the reversals allows, the zero within 1 kPa (7 N on the piston), and the rig
     // file's zero (0) is rejected.
-    let rig = Rig::nominal();
-    let log = sliding_log(both_ways, COULOMB_N);
-    let facts = LogFacts::of(&log, &rig);
-    let rel = CylinderRelation::of(&log, &facts, &rig).expect("the piston moves");
-    assert!(rel.strokes_both_ways());
-    let rows = facts.windows(facts.identification(), 1.0);
-    let (t, at_zero) = test_release_at_nominal(
-        &rel,
-        &rows,
-        Release::CylinderFriction,
-        &calibrate(&rel, &rows),
-        ix::ZERO,
-        rel.strokes_both_ways(),
-    );
-    let f = &t.fitted.values;
-    assert!(!at_zero, "{f:?}");
-    assert!((f[ix::ZERO] - ZERO_PA).abs() < 1e3, "{f:?}");
-    assert!(
-        (f[ix::COULOMB] - COULOMB_N).abs() < 0.01 * COULOMB_N,
-        "{f:?}"
-    );
+    on_sliding_log(both_ways, COULOMB_N, |_, rel, rows| {
+        assert!(rel.strokes_both_ways());
+        let (t, at_zero) = friction_at_rig_zero(rel, rows);
+        let f = &t.fitted.values;
+        assert!(!at_zero, "{f:?}");
+        assert!((f[ix::ZERO] - ZERO_PA).abs() < 1e3, "{f:?}");
+        assert!(
+            (f[ix::COULOMB] - COULOMB_N).abs() < 0.01 * COULOMB_N,
+            "{f:?}"
+        );
+    });
 }
 
 #[test]
@@ -237,62 +255,41 @@ fn along_a_one_way_stroke_a_zero_within_its_band_is_no_friction() {
     // pressure step, within what the zero's ±30 kPa (213 N) explains. Released, the
     // friction gains nothing significant; with the zero held at the rig file's value
     // the same step would be convicted.
-    let rig = Rig::nominal();
-    let nominal = rig.cylinder.coulomb_friction_n;
-    let log = sliding_log(one_way, nominal);
-    let facts = LogFacts::of(&log, &rig);
-    let rel = CylinderRelation::of(&log, &facts, &rig).expect("the piston moves");
-    assert!(!rel.strokes_both_ways());
-    let rows = facts.windows(facts.identification(), 1.0);
-    let base = calibrate(&rel, &rows);
-    let (t, at_zero) = test_release_at_nominal(
-        &rel,
-        &rows,
-        Release::CylinderFriction,
-        &base,
-        ix::ZERO,
-        false,
-    );
-    assert!(at_zero);
-    assert!(t.lambda < threshold(1), "Λ = {}", t.lambda);
-    // Read at the rig file's zero, the friction is the whole step: 15 N + A·20 kPa.
-    let apparent = nominal + ZERO_PA * rig.cylinder.area_m2;
-    let f = &t.fitted.values;
-    assert!((f[ix::ZERO] - 0.0).abs() < 1e-6, "{f:?}");
-    assert!((f[ix::COULOMB] - apparent).abs() < 0.01 * apparent, "{f:?}");
-    let held = Pinned {
-        relation: &rel,
-        index: ix::ZERO,
-        value: 0.0,
-    };
-    let convicted = test_release(
-        &held,
-        &rows,
-        Release::CylinderFriction,
-        &calibrate(&held, &rows),
-    );
-    assert!(convicted.lambda > threshold(1), "Λ = {}", convicted.lambda);
+    let nominal = Rig::nominal().cylinder.coulomb_friction_n;
+    on_sliding_log(one_way, nominal, |rig, rel, rows| {
+        assert!(!rel.strokes_both_ways());
+        let (t, at_zero) = friction_at_rig_zero(rel, rows);
+        assert!(at_zero);
+        assert!(t.lambda < threshold(1), "Λ = {}", t.lambda);
+        // Read at the rig file's zero, the friction is the whole step: 15 N + A·20 kPa.
+        let apparent = nominal + ZERO_PA * rig.cylinder.area_m2;
+        let f = &t.fitted.values;
+        assert!((f[ix::ZERO] - 0.0).abs() < 1e-6, "{f:?}");
+        assert!((f[ix::COULOMB] - apparent).abs() < 0.01 * apparent, "{f:?}");
+        let held = Pinned {
+            relation: rel,
+            index: ix::ZERO,
+            value: 0.0,
+        };
+        let convicted = test_release(
+            &held,
+            rows,
+            Release::CylinderFriction,
+            &calibrate(&held, rows),
+        );
+        assert!(convicted.lambda > threshold(1), "Λ = {}", convicted.lambda);
+    });
 }
 
 #[test]
 fn along_a_one_way_stroke_friction_beyond_the_band_is_read_at_the_rig_zero() {
     // 400 N of Coulomb force with the zero 20 kPa high: named, and read as the step
     // at the rig file's zero, 400 N + A·20 kPa = 542 N (the log cannot split it).
-    let rig = Rig::nominal();
-    let log = sliding_log(one_way, COULOMB_N);
-    let facts = LogFacts::of(&log, &rig);
-    let rel = CylinderRelation::of(&log, &facts, &rig).expect("the piston moves");
-    let rows = facts.windows(facts.identification(), 1.0);
-    let (t, at_zero) = test_release_at_nominal(
-        &rel,
-        &rows,
-        Release::CylinderFriction,
-        &calibrate(&rel, &rows),
-        ix::ZERO,
-        rel.strokes_both_ways(),
-    );
-    assert!(at_zero && t.lambda > threshold(1), "Λ = {}", t.lambda);
-    let apparent = COULOMB_N + ZERO_PA * rig.cylinder.area_m2;
-    let f = &t.fitted.values;
-    assert!((f[ix::COULOMB] - apparent).abs() < 0.01 * apparent, "{f:?}");
+    on_sliding_log(one_way, COULOMB_N, |rig, rel, rows| {
+        let (t, at_zero) = friction_at_rig_zero(rel, rows);
+        assert!(at_zero && t.lambda > threshold(1), "Λ = {}", t.lambda);
+        let apparent = COULOMB_N + ZERO_PA * rig.cylinder.area_m2;
+        let f = &t.fitted.values;
+        assert!((f[ix::COULOMB] - apparent).abs() < 0.01 * apparent, "{f:?}");
+    });
 }
