@@ -289,31 +289,7 @@ pub fn test_release<R: Relation>(
             .sum();
         weighed_sse(relation, v, rows, scale) + prior
     };
-    let mut start = base.fitted.values.clone();
-    // A parameter the release frees besides the grid's starts where the released search
-    // space puts it (read off the log), not at the band's edge the baseline left it at.
-    let grid = relation.released(release);
-    let base_specs = relation.specs(Release::Nothing);
-    for (k, (s, b)) in specs.iter().zip(&base_specs).enumerate() {
-        if s.band.is_none() && b.band.is_some() && grid.as_ref().is_none_or(|(g, _)| *g != k) {
-            start[k] = s.value(s.start);
-        }
-    }
-    if let Some((k, grid)) = grid {
-        let best = grid
-            .iter()
-            .map(|g| {
-                let mut v = start.clone();
-                v[k] = *g;
-                (objective_at(&v, base.scale), v)
-            })
-            .min_by(|a, b| a.0.total_cmp(&b.0));
-        if let Some((j, v)) = best {
-            if j < objective_at(&start, base.scale) {
-                start = v;
-            }
-        }
-    }
+    let start = release_start(relation, release, base, |v| objective_at(v, base.scale));
     let first = fit_relation(relation, rows, release, base.scale, Some(&start));
     let scale =
         variance_per_independent_sample(&relation.residuals(&first.values, rows)).min(base.scale);
@@ -350,6 +326,50 @@ pub fn test_release<R: Relation>(
         baseline,
         scale,
     }
+}
+
+/// Where the released fit of `release` starts: the grid's best point along the released
+/// parameter, the other parameters either as `base` calibrated them or at their own starts
+/// (the rig file's values), whichever fits better by `objective`. The calibration may
+/// have pushed other tolerances to their band edges to mimic the effect (a smaller
+/// absorber shell and a larger displacement for a lower precharge); with them there, the
+/// effect's true value fits worse than the nominal one and a local search stays put.
+fn release_start<R: Relation>(
+    relation: &R,
+    release: Release,
+    base: &Calibration,
+    objective: impl Fn(&[f64]) -> f64,
+) -> Vec<f64> {
+    let specs = relation.specs(release);
+    let base_specs = relation.specs(Release::Nothing);
+    let grid = relation.released(release);
+    // A parameter the release frees besides the grid's starts where the released search
+    // space puts it (read off the log), not at the band's edge the baseline left it at.
+    let freed = |mut v: Vec<f64>| {
+        for (k, (s, b)) in specs.iter().zip(&base_specs).enumerate() {
+            if s.band.is_none() && b.band.is_some() && grid.as_ref().is_none_or(|(g, _)| *g != k) {
+                v[k] = s.value(s.start);
+            }
+        }
+        v
+    };
+    let calibrated = freed(base.fitted.values.clone());
+    let Some((k, points)) = &grid else {
+        return calibrated;
+    };
+    let nominal = freed(base_specs.iter().map(|s| s.value(s.start)).collect());
+    let mut best = (objective(&calibrated), calibrated.clone());
+    for from in [&calibrated, &nominal] {
+        for g in points {
+            let mut v = from.clone();
+            v[*k] = *g;
+            let o = objective(&v);
+            if o < best.0 {
+                best = (o, v);
+            }
+        }
+    }
+    best.1
 }
 
 /// The weighed squared residuals of `relation` at `values` over `rows`. [1]

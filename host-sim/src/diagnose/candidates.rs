@@ -186,6 +186,10 @@ pub fn from_release<R: Relation>(
     }
 }
 
+/// Largest standard error shown, relative to the estimate: beyond it the linearised
+/// error says only that the log does not bound the parameter by itself. [1]
+const SPREAD_SHOWN: f64 = 100.0;
+
 /// What a release measured, in words: each released parameter's estimate, its standard
 /// error and band, and Λ.
 fn release_evidence(
@@ -201,11 +205,17 @@ fn release_evidence(
             let value = specs[i].value(u);
             let se = test.fitted.standard_error(i, 1.0);
             let spread = (specs[i].value(u + se) - value).abs();
+            // A direction the log leaves flat has no finite error: above the precharge
+            // p₀ the gas's capacitance V₀·p₀^(1/n)/(n·p^(1+1/n)) sets p₀ against V₀.
+            let error = if spread.is_finite() && spread <= SPREAD_SHOWN * value.abs() {
+                format!("± {} at one standard error", short(spread))
+            } else {
+                "standard error unbounded: the log trades it against another parameter".to_string()
+            };
             format!(
-                "{} released from its tolerance band to {} (± {} at one standard error, band {})",
+                "{} released from its tolerance band to {} ({error}, band {})",
                 specs[i].name,
                 short(value),
-                short(spread),
                 band_text(&base_specs[i])
             )
         })

@@ -39,6 +39,8 @@ pub mod lines;
 pub mod mechanical;
 pub mod mechanical_relation;
 pub mod predictions;
+#[cfg(test)]
+mod release_tests;
 pub mod report;
 pub mod result;
 pub mod signatures;
