@@ -18,8 +18,12 @@ fn main() {
     for seed in from..to {
         let d = draw(seed);
         println!(
-            "{seed} {} {} dropped={:?} {:?}",
-            d.truth.effect_name, d.truth.scenario, d.structure.dropped, d.truth.parameters
+            "{seed} {} {} dropped={:?} {:?} {:?}",
+            d.truth.effect_name,
+            d.truth.scenario,
+            d.structure.dropped,
+            d.truth.parameters,
+            d.structure.controller
         );
     }
 }
