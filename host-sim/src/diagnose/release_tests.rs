@@ -19,7 +19,9 @@ const PRECHARGE_PA: f64 = 2.1e6;
 /// White noise on the logged pressure. [Pa]
 const NOISE_PA: f64 = 2e3;
 
-/// Oil the absorber holds at gauge pressure `p` (eq. 22): V₀·(1 − ((p₀+p_a)/(p+p_a))^(1/n)).
+/// Oil the absorber holds at gauge pressure `p` (eq. 22): V₀·(1 − ((p₀+p_a)/(p+p_a))^(1/n)),
+/// written out here rather than taken from `plant_model::accumulator::GasCharge`, which the
+/// diagnosis's own hydraulic model calls.
 fn absorber_oil(rig: &Rig, p: f64) -> f64 {
     let a = &rig.absorber;
     let ratio = (PRECHARGE_PA + ATMOSPHERE_PA) / (p + ATMOSPHERE_PA);

@@ -48,14 +48,22 @@ fn breakaway_log() -> BenchLog {
             }
         })
         .unzip();
+    let p = force
+        .iter()
+        .zip(gaussian(n, 17))
+        .map(|(f, e)| P_LOW_PA + f / area + NOISE_PA * e)
+        .collect();
+    piston_log(t, x, p)
+}
+
+/// A log of the piston alone: times `t`, position `x` and port pressure `p`, the low side
+/// at [`P_LOW_PA`] logged and set as the reference, the shaft at rest.
+fn piston_log(t: Vec<f64>, x: Vec<f64>, p: Vec<f64>) -> BenchLog {
+    let n = t.len();
     BenchLog {
         t_s: t,
         p_ref_pa: vec![P_LOW_PA; n],
-        p_pa: force
-            .iter()
-            .zip(gaussian(n, 17))
-            .map(|(f, e)| P_LOW_PA + f / area + NOISE_PA * e)
-            .collect(),
+        p_pa: p,
         speed_rad_s: vec![0.0; n],
         iq_a: vec![0.0; n],
         id_a: vec![0.0; n],
@@ -177,17 +185,7 @@ fn sliding_log(motion: impl Fn(f64) -> (f64, f64, f64), coulomb: f64) -> BenchLo
             (x, P_LOW_PA + f / c.area_m2 + ZERO_PA + NOISE_PA * e)
         })
         .unzip();
-    BenchLog {
-        t_s: t,
-        p_ref_pa: vec![P_LOW_PA; n],
-        p_pa: p,
-        speed_rad_s: vec![0.0; n],
-        iq_a: vec![0.0; n],
-        id_a: vec![0.0; n],
-        x_m: Some(x),
-        p_low_pa: Some(vec![P_LOW_PA; n]),
-        ..BenchLog::default()
-    }
+    piston_log(t, x, p)
 }
 
 /// 10 mm of stroke each way at 0.25 Hz: the Coulomb force's step changes sign twice.
