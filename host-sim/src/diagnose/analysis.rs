@@ -16,14 +16,14 @@
 use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
 use super::calibration::{
     calibrate, mech, test_release_at_nominal, thinned, Calibration, HydraulicRelation,
-    MechanicalRelation, Patient, Release, HYDRAULIC_WINDOW_S,
+    MechanicalRelation, Patient, Release, HYDRAULIC_WINDOW_S, MAX_FIT_S,
 };
 use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
 use super::cylinder::{self, CylinderRelation};
 use super::decision::{apply_vetoes, decide};
 use super::diagnosis::Diagnosis;
 use super::electrical::ElectricalRelation;
-use super::facts::LogFacts;
+use super::facts::{rows_spanning, LogFacts};
 use super::least_squares::{PATIENCE, THOROUGH_PATIENCE};
 use super::lines::window_lines;
 use super::mechanical::ShaftMotion;
@@ -153,7 +153,9 @@ impl<'a> Relations<'a> {
         rig: &'a Rig,
         precision: Precision,
     ) -> Relations<'a> {
-        let windows = |rows, length, signal: &[f64]| thinned(facts.windows(rows, length), signal);
+        let budget = rows_spanning(MAX_FIT_S, facts.period_s, 1);
+        let windows =
+            |rows, length, signal: &[f64]| thinned(facts.windows(rows, length), signal, budget);
         let orders = line_orders(rig);
         Relations {
             h_id: windows(facts.identification(), HYDRAULIC_WINDOW_S, &log.p_pa),

@@ -43,10 +43,11 @@ pub use crate::diagnose::mechanical_relation::{
     SHAFT_COULOMB_BAND_NM, SPEED_WINDOW_S,
 };
 
-/// Most rows a fit evaluates per model run: longer segments are thinned
-/// ([`thinned`]). Twelve seconds at 1 kHz fix every rig parameter the relations carry;
-/// more only narrows error bars already far inside the bands. [1]
-pub const MAX_FIT_ROWS: usize = 12_000;
+/// Most log time a fit evaluates per model run: longer segments are thinned
+/// ([`thinned`]). Twelve seconds fix every rig parameter the relations carry; more only
+/// narrows error bars already far inside the bands. A span in time, not rows: a fast log
+/// thinned to a row budget would keep a few windows and fit the tolerances to them. [s]
+pub const MAX_FIT_S: f64 = 12.0;
 
 /// Which parameter of a relation an effect releases from its band.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,16 +70,16 @@ pub enum Release {
     CylinderFriction,
 }
 
-/// `windows` thinned to at most [`MAX_FIT_ROWS`] rows together: half of the budget to the
+/// `windows` thinned to at most `max_rows` rows together ([`MAX_FIT_S`] of the log): half of the budget to the
 /// windows where `signal` moves most (its range within the window: the steps, fills and
 /// starts where the effects show), the rest spread evenly over the others, in time order.
-pub fn thinned(windows: Vec<Range<usize>>, signal: &[f64]) -> Vec<Range<usize>> {
+pub fn thinned(windows: Vec<Range<usize>>, signal: &[f64], max_rows: usize) -> Vec<Range<usize>> {
     let rows: usize = windows.iter().map(|w| w.len()).sum();
-    if rows <= MAX_FIT_ROWS {
+    if rows <= max_rows {
         return windows;
     }
     let per_window = (rows / windows.len().max(1)).max(1);
-    let keep = (MAX_FIT_ROWS / per_window).clamp(1, windows.len());
+    let keep = (max_rows / per_window).clamp(1, windows.len());
     let range = |w: &Range<usize>| {
         let s = &signal[w.clone()];
         let (lo, hi) = s
@@ -124,7 +125,15 @@ pub trait Relation: Sync {
     fn patience(&self) -> usize {
         PATIENCE
     }
+    /// Rows whose residuals are averaged before their correlation time is read
+    /// ([`variance_per_independent_sample`]): [`CORRELATION_BIN_S`] of the log.
+    fn correlation_bin(&self) -> usize;
 }
+
+/// Span of the blocks a relation's residuals are averaged over before their correlation
+/// time is read: one row of a 1 kHz log, so faster logs weigh their residuals as a 1 kHz
+/// log of the same bench does. [s]
+pub const CORRELATION_BIN_S: f64 = 1e-3;
 
 /// `nominal` times each of `factors`.
 pub fn scaled(nominal: f64, factors: &[f64]) -> Vec<f64> {
@@ -151,6 +160,9 @@ impl<R: Relation> Relation for Patient<'_, R> {
     }
     fn patience(&self) -> usize {
         self.patience
+    }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
     }
 }
 
@@ -183,6 +195,9 @@ impl<R: Relation> Relation for Pinned<'_, R> {
     }
     fn patience(&self) -> usize {
         self.relation.patience()
+    }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
     }
 }
 
@@ -226,9 +241,10 @@ pub fn fit_relation<R: Relation>(
 pub fn calibrate<R: Relation>(relation: &R, rows: &[Range<usize>]) -> Calibration {
     let specs = relation.specs(Release::Nothing);
     let nominal: Vec<f64> = specs.iter().map(|s| s.value(s.start)).collect();
-    let scale0 = variance_per_independent_sample(&relation.residuals(&nominal, rows));
+    let bin = relation.correlation_bin();
+    let scale0 = variance_per_independent_sample(&relation.residuals(&nominal, rows), bin);
     let first = fit_relation(relation, rows, Release::Nothing, scale0, None);
-    let scale = variance_per_independent_sample(&relation.residuals(&first.values, rows));
+    let scale = variance_per_independent_sample(&relation.residuals(&first.values, rows), bin);
     let fitted = reweighed(relation, rows, Release::Nothing, &first, scale0, scale);
     Calibration { fitted, scale }
 }
@@ -291,8 +307,11 @@ pub fn test_release<R: Relation>(
     };
     let start = release_start(relation, release, base, |v| objective_at(v, base.scale));
     let first = fit_relation(relation, rows, release, base.scale, Some(&start));
-    let scale =
-        variance_per_independent_sample(&relation.residuals(&first.values, rows)).min(base.scale);
+    let scale = variance_per_independent_sample(
+        &relation.residuals(&first.values, rows),
+        relation.correlation_bin(),
+    )
+    .min(base.scale);
     let fitted = reweighed(relation, rows, release, &first, base.scale, scale);
     // The baseline: the calibration, or a fit within the bands from the released optimum
     // brought into them, whichever is better. A baseline stopped short of its optimum

@@ -11,17 +11,21 @@
 //! controller, regulating the currents, adds to its command. A dead time the model lacks
 //! shows as a voltage along the current with a sixth-harmonic ripple. The relation is
 //! algebraic: one pass over the log per evaluation; the derivatives are central
-//! differences of the logged currents.
+//! differences of the logged currents over ±[`CURRENT_RATE_HALF_WIDTH_S`].
 
 use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::back_emf::Stator;
-use crate::diagnose::calibration::{Relation, Release};
-use crate::diagnose::facts::LogFacts;
+use crate::diagnose::calibration::{Relation, Release, CORRELATION_BIN_S};
+use crate::diagnose::facts::{rows_spanning, LogFacts};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use plant_model::rig::InverterParams;
 use plant_model::Rig;
 use std::ops::Range;
+
+/// Time on each side of the currents' central differences (one row of a 1 kHz log): a
+/// faster log's current noise is not differentiated over a shorter interval. [s]
+pub const CURRENT_RATE_HALF_WIDTH_S: f64 = 1e-3;
 
 /// Upper end of the dead time's tolerance band: the rig file says 0, a residual error
 /// below this is a compensated inverter's. [s]
@@ -95,8 +99,9 @@ impl<'a> ElectricalRelation<'a> {
             dead_time_s: v[ix::DEAD_TIME],
             ..self.rig.inverter.clone()
         });
+        let h = rows_spanning(CURRENT_RATE_HALF_WIDTH_S, self.facts.period_s, 1);
         let deriv = |y: &[f64], k: usize| {
-            let (a, b) = (k.saturating_sub(1), (k + 1).min(n - 1));
+            let (a, b) = (k.saturating_sub(h), (k + h).min(n - 1));
             if b > a {
                 (y[b] - y[a]) / (t[b] - t[a])
             } else {
@@ -124,6 +129,9 @@ impl<'a> ElectricalRelation<'a> {
 }
 
 impl Relation for ElectricalRelation<'_> {
+    fn correlation_bin(&self) -> usize {
+        rows_spanning(CORRELATION_BIN_S, self.facts.period_s, 1)
+    }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         let m = &self.rig.motor;
         let mut dead = ParamSpec::linear("dead_time_s", 0.0, 1e-7, 0.0, 10e-6);

@@ -197,6 +197,18 @@ impl LogFacts {
     }
 }
 
+/// Rows spanning `seconds` at the sampling `period_s`, at least `min_rows`: the spans of
+/// differences and fits are set in time, so a faster log is not differentiated over a
+/// shorter interval.
+pub fn rows_spanning(seconds: f64, period_s: f64, min_rows: usize) -> usize {
+    let rows = (seconds / period_s.max(f64::MIN_POSITIVE)).round();
+    if rows.is_finite() && rows >= min_rows as f64 {
+        rows.min(1e6) as usize
+    } else {
+        min_rows
+    }
+}
+
 /// Median of the sampling intervals of `t` (at least two rows). [s]
 fn median_period(t: &[f64]) -> f64 {
     let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();

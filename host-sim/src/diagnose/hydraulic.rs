@@ -24,12 +24,12 @@
 //! which an explicit rule could only follow with microsecond steps.
 //!
 //! Window starts (multiple shooting): the transducer's state and the pressure's slope from a
-//! straight line through the window's first [`START_ROWS`] measured rows; the true pressure
+//! straight line through the window's first [`START_S`] of measured rows; the true pressure
 //! the one whose prediction fits the window best in least squares (the window is nearly
 //! linear in it: two runs give the sensitivity); the absorber in equilibrium with it and
 //! filling at the slope.
 
-use crate::diagnose::facts::LogFacts;
+use crate::diagnose::facts::{rows_spanning, LogFacts};
 use plant_model::accumulator::{GasCharge, ATMOSPHERE_PA};
 use plant_model::pump::Pump;
 use plant_model::Rig;
@@ -39,8 +39,10 @@ use std::ops::Range;
 /// Longest integration substep. [s]
 pub const MAX_SUBSTEP_S: f64 = 0.5e-3;
 
-/// Measured rows a window's starting pressure and slope are fitted to.
-pub const START_ROWS: usize = 10;
+/// Span of the measured rows a window's starting pressure and slope are fitted to (ten
+/// rows of a 1 kHz log): a span in time, so a faster log's noise does not tilt the slope
+/// that starts the transducer and the absorber's inlet. [s]
+pub const START_S: f64 = 10e-3;
 
 /// The hydraulic model's parameters (SI).
 #[derive(Clone, Debug)]
@@ -130,6 +132,8 @@ pub struct HydraulicInputs<'a> {
     pub x_m: Option<&'a [f64]>,
     /// Measured pressure (window starts). [Pa]
     pub p_pa: &'a [f64],
+    /// Rows a window's start is fitted to ([`START_S`] at the log's sampling).
+    pub start_rows: usize,
 }
 
 impl<'a> HydraulicInputs<'a> {
@@ -141,6 +145,7 @@ impl<'a> HydraulicInputs<'a> {
             p_low_pa: &facts.p_low_pa,
             x_m: log.x_m.as_deref().filter(|_| facts.piston_moves),
             p_pa: &log.p_pa,
+            start_rows: rows_spanning(START_S, facts.period_s, 2),
         }
     }
 }
@@ -219,7 +224,7 @@ impl Hydraulics {
 
     fn predict_window(&self, x: &HydraulicInputs<'_>, rows: Range<usize>, out: &mut [f64]) {
         let hp = &self.params;
-        let head = rows.start..(rows.start + START_ROWS).min(rows.end);
+        let head = rows.start..(rows.start + x.start_rows).min(rows.end);
         let (s0, slope) = line_start(&x.t_s[head.clone()], &x.p_pa[head]);
         let gain = hp.sensor_gain.max(1e-6);
         let s_true = (s0 - hp.sensor_offset_pa) / gain;
@@ -391,6 +396,7 @@ mod tests {
             p_low_pa: &pl,
             x_m: None,
             p_pa: &p,
+            start_rows: 10,
         };
         let mut out = vec![0.0; n];
         Hydraulics::new(hp.clone(), &Rig::nominal()).simulate_window(

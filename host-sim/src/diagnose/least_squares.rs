@@ -190,24 +190,36 @@ pub fn huber(r: f64) -> f64 {
 /// its integrated autocorrelation time κ = 1 + 2·Σ ρ_l, summed with Sokal's automatic
 /// window (stop at the first lag l ≥ 5·κ(l)). Divided by it, the squared residuals of a
 /// series whose errors are correlated over κ rows count as N/κ independent ones, which is
-/// what a likelihood ratio may rely on. [unit²]
-pub fn variance_per_independent_sample(r: &[f64]) -> f64 {
-    let n = r.len();
+/// what a likelihood ratio may rely on.
+///
+/// The series is first averaged over blocks of `bin` rows (blocking, Flyvbjerg & Petersen
+/// 1989) and κ read on the block means, the result scaled back to one row: white noise
+/// gives its variance whatever `bin`, while a model error correlated over a time T counts
+/// T/bin blocks. With `bin` rows spanning a fixed time, the weighing does not depend on the
+/// log's rate: Sokal's window, counted in rows, would otherwise stop ten times too early
+/// on a 10 kHz log and take a slow model error for white noise. [unit²]
+pub fn variance_per_independent_sample(r: &[f64], bin: usize) -> f64 {
+    let bin = bin.max(1);
+    let blocks: Vec<f64> = r
+        .chunks_exact(bin)
+        .map(|c| c.iter().sum::<f64>() / bin as f64)
+        .collect();
+    let n = blocks.len();
     if n < 4 {
         return 1.0;
     }
-    let mean = r.iter().sum::<f64>() / n as f64;
-    let var = r.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n as f64;
-    let ms = r.iter().map(|x| x * x).sum::<f64>() / n as f64;
+    let mean = blocks.iter().sum::<f64>() / n as f64;
+    let var = blocks.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n as f64;
+    let ms = blocks.iter().map(|x| x * x).sum::<f64>() / n as f64;
     if var <= 0.0 {
-        return ms.max(f64::MIN_POSITIVE);
+        return (ms * bin as f64).max(f64::MIN_POSITIVE);
     }
     let mut tau = 1.0;
     let max_lag = (n / 4).min(2000);
     for l in 1..max_lag {
-        let c = r[..n - l]
+        let c = blocks[..n - l]
             .iter()
-            .zip(&r[l..])
+            .zip(&blocks[l..])
             .map(|(a, b)| (a - mean) * (b - mean))
             .sum::<f64>()
             / (n as f64 * var);
@@ -216,7 +228,7 @@ pub fn variance_per_independent_sample(r: &[f64]) -> f64 {
             break;
         }
     }
-    ms.max(f64::MIN_POSITIVE) * tau.max(1.0)
+    (ms * bin as f64).max(f64::MIN_POSITIVE) * tau.max(1.0)
 }
 
 /// Residuals of a model at parameter values: data rows already divided by their noise
@@ -467,6 +479,37 @@ fn covariance<M: Model>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::test_noise::gaussian;
+
+    #[test]
+    fn blocks_of_a_millisecond_read_a_slow_error_under_fast_white_noise() {
+        // A 10 kHz residual: unit white noise plus 0.3 of an AR(1) error whose correlation
+        // time is 5 ms (ρ = e^(−0.1/5) per row). Per independent row it carries
+        // 1 + 0.09·(1 + ρ)/(1 − ρ) = 9.9 (the AR(1) sum Σ ρ^|l|); Sokal's window on the
+        // raw rows stops within a few lags and reads about a third of it.
+        let (n, rho) = (200_000, (-0.1f64 / 5.0).exp());
+        let (w, e) = (gaussian(n, 11), gaussian(n, 12));
+        let mut c = 0.0;
+        let r: Vec<f64> = (0..n)
+            .map(|k| {
+                c = rho * c + (1.0 - rho * rho).sqrt() * e[k];
+                w[k] + 0.3 * c
+            })
+            .collect();
+        let expected = 1.0 + 0.09 * (1.0 + rho) / (1.0 - rho);
+        let blocked = variance_per_independent_sample(&r, 10);
+        assert!(
+            (blocked / expected - 1.0).abs() < 0.15,
+            "{blocked} against {expected}"
+        );
+        let raw = variance_per_independent_sample(&r, 1);
+        assert!(raw < 0.5 * expected, "{raw}");
+        // White noise alone reads its variance whatever the blocks.
+        for bin in [1, 10] {
+            let v = variance_per_independent_sample(&w, bin);
+            assert!((v - 1.0).abs() < 0.05, "bin {bin}: {v}");
+        }
+    }
 
     #[test]
     fn an_exponential_decay_is_fitted_and_its_error_bars_are_the_textbook_ones() {

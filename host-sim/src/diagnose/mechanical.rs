@@ -17,12 +17,12 @@
 //!   short windows re-started from the logged speed (multiple shooting), so a torque error
 //!   shows as a slope within each window and never as a drift.
 //!
-//! The speed's derivative is the central difference over ±[`RATE_HALF_WIDTH`] rows of the
+//! The speed's derivative is the central difference over ±[`RATE_HALF_WIDTH_S`] of the
 //! speed the logged angle gives (or of the logged speed): one encoder count over one log
 //! interval is a speed step far larger than the current's noise.
 
 use crate::bench_log::BenchLog;
-use crate::diagnose::facts::LogFacts;
+use crate::diagnose::facts::{rows_spanning, LogFacts};
 use plant_model::motor::Motor;
 use plant_model::pump::Pump;
 use plant_model::rig::{MotorParams, PumpParams};
@@ -31,8 +31,14 @@ use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
 use std::ops::Range;
 
-/// Rows on each side of the central differences that give speed and acceleration.
-pub const RATE_HALF_WIDTH: usize = 5;
+/// Time on each side of the central differences that give speed and acceleration (five
+/// rows of a 1 kHz log): a span in time, so a faster log's encoder quantisation is not
+/// differentiated over a shorter interval. [s]
+pub const RATE_HALF_WIDTH_S: f64 = 5e-3;
+
+/// Half-width of the Savitzky–Golay window of the shaft's acceleration (three rows of a
+/// 1 kHz log). [s]
+pub const SAVGOL_HALF_WIDTH_S: f64 = 3e-3;
 
 /// Speed over which the Coulomb torque's sign fades in (a smooth sgn). [rad/s]
 pub const COULOMB_FADE_RAD_S: f64 = 0.5;
@@ -123,29 +129,37 @@ pub fn central_rate(t: &[f64], y: &[f64], h: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The second derivative of `y` by a quadratic Savitzky–Golay fit over ±3 rows (uniform
-/// sampling at `period` assumed; the ends repeat their neighbour's): flat to about a tenth
-/// of the sampling rate, so the shaft's oscillation at the angle-locked orders keeps its
-/// acceleration, while the encoder's quantisation is amplified 4.6 times less than by a
-/// second difference.
-pub fn savgol_second_derivative(y: &[f64], period: f64) -> Vec<f64> {
-    const C: [f64; 7] = [5.0, 0.0, -3.0, -4.0, -3.0, 0.0, 5.0];
+/// The second derivative of `y` by a quadratic Savitzky–Golay fit over ±`m` rows (at
+/// least 1; uniform sampling at `period` assumed; the ends repeat their neighbour's). The
+/// fitted quadratic's curvature is 2·Σ c_j·y_j / (Σ c_j²·period²) with c_j = j² − ⟨j²⟩;
+/// over ±3 rows it is flat to about a tenth of the sampling rate, so the shaft's
+/// oscillation at the angle-locked orders keeps its acceleration, while the encoder's
+/// quantisation is amplified 4.6 times less than by a second difference.
+pub fn savgol_second_derivative(y: &[f64], period: f64, m: usize) -> Vec<f64> {
+    let m = m.max(1);
     let n = y.len();
     let mut out = vec![0.0; n];
-    if n < 7 {
+    if n < 2 * m + 1 {
         return out;
     }
-    let scale = 1.0 / (42.0 * period * period);
-    for k in 3..n - 3 {
+    let mean_j2 = (m * (m + 1)) as f64 / 3.0;
+    let c: Vec<f64> = (0..=2 * m)
+        .map(|i| {
+            let j = i as f64 - m as f64;
+            j * j - mean_j2
+        })
+        .collect();
+    let scale = 2.0 / (c.iter().map(|c| c * c).sum::<f64>() * period * period);
+    for k in m..n - m {
         out[k] = scale
-            * C.iter()
-                .enumerate()
-                .map(|(j, c)| c * y[k + j - 3])
+            * c.iter()
+                .zip(&y[k - m..=k + m])
+                .map(|(c, y)| c * y)
                 .sum::<f64>();
     }
-    for k in 0..3 {
-        out[k] = out[3];
-        out[n - 1 - k] = out[n - 4];
+    for k in 0..m {
+        out[k] = out[m];
+        out[n - 1 - k] = out[n - 1 - m];
     }
     out
 }
@@ -154,16 +168,18 @@ impl ShaftMotion {
     /// The shaft's motion in `log`, its acceleration keeping the angle-locked orders
     /// ([`savgol_second_derivative`]).
     pub fn of(log: &BenchLog, facts: &LogFacts) -> ShaftMotion {
+        let h = rows_spanning(RATE_HALF_WIDTH_S, facts.period_s, 1);
         let (speed, accel) = if facts.angle_logged {
-            let speed = central_rate(&log.t_s, &facts.theta_rad, RATE_HALF_WIDTH);
+            let speed = central_rate(&log.t_s, &facts.theta_rad, h);
             let accel = if facts.uniform {
-                savgol_second_derivative(&facts.theta_rad, facts.period_s)
+                let m = rows_spanning(SAVGOL_HALF_WIDTH_S, facts.period_s, 1);
+                savgol_second_derivative(&facts.theta_rad, facts.period_s, m)
             } else {
-                central_rate(&log.t_s, &speed, RATE_HALF_WIDTH)
+                central_rate(&log.t_s, &speed, h)
             };
             (speed, accel)
         } else {
-            let accel = central_rate(&log.t_s, &log.speed_rad_s, RATE_HALF_WIDTH);
+            let accel = central_rate(&log.t_s, &log.speed_rad_s, h);
             (log.speed_rad_s.clone(), accel)
         };
         ShaftMotion {
@@ -339,6 +355,36 @@ pub fn ripple_fundamental_per_ratio(rig: &Rig, pistons: u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn savitzky_golay_is_exact_on_a_parabola_and_quieter_over_a_wider_window() {
+        // y = 3·t² has y'' = 6 at any half-width; over ±m rows white noise of unit variance
+        // gives y'' a variance of 4/(Σ c_j²·h⁴), Σ c_j² = m(m+1)(2m+1)(2m+3)(2m−1)/45.
+        let h = 1e-4;
+        let y: Vec<f64> = (0..400).map(|k| 3.0 * (k as f64 * h).powi(2)).collect();
+        for m in [1, 3, 30] {
+            let d = savgol_second_derivative(&y, h, m);
+            assert!(
+                d.iter().all(|v| (v - 6.0).abs() < 1e-6),
+                "m = {m}: {}",
+                d[200]
+            );
+        }
+        let noise = crate::diagnose::test_noise::gaussian(200_000, 5);
+        for m in [3usize, 30] {
+            let d = savgol_second_derivative(&noise, h, m);
+            let var =
+                d[m..d.len() - m].iter().map(|v| v * v).sum::<f64>() / (d.len() - 2 * m) as f64;
+            let mf = m as f64;
+            let sum_c2 =
+                mf * (mf + 1.0) * (2.0 * mf + 1.0) * (2.0 * mf + 3.0) * (2.0 * mf - 1.0) / 45.0;
+            let expected = 4.0 / (sum_c2 * h.powi(4));
+            assert!(
+                (var / expected - 1.0).abs() < 0.05,
+                "m = {m}: {var} against {expected}"
+            );
+        }
+    }
 
     #[test]
     fn the_kinematic_ripples_fundamental_is_that_of_a_periodic_parabola() {

@@ -4,8 +4,8 @@
 //! alone.
 
 use crate::bench_log::BenchLog;
-use crate::diagnose::calibration::{calibrate, test_release, thinned, Release};
-use crate::diagnose::facts::LogFacts;
+use crate::diagnose::calibration::{calibrate, test_release, thinned, Release, MAX_FIT_S};
+use crate::diagnose::facts::{rows_spanning, LogFacts};
 use crate::diagnose::hydraulic::nominal_leakage;
 use crate::diagnose::hydraulic_relation::{hyd, HydraulicRelation, HYDRAULIC_WINDOW_S};
 use crate::diagnose::test_noise::gaussian;
@@ -92,6 +92,7 @@ fn a_precharge_below_the_starting_pressure_is_found_from_the_rig_files_values() 
     let rows = thinned(
         facts.windows(facts.identification(), HYDRAULIC_WINDOW_S),
         &log.p_pa,
+        rows_spanning(MAX_FIT_S, facts.period_s, 1),
     );
     let base = calibrate(&relation, &rows);
     let test = test_release(&relation, &rows, Release::Precharge, &base);

@@ -2,7 +2,7 @@
 //! friction model (`plant_model::friction`) read from the position column.
 //!
 //! A stuck piston does not move at all, so a row rests when the position stayed, over it
-//! and the [`REST_WINDOW_ROWS`] rows before it, within what the transducer resolves:
+//! and the `window` rows before it (the span of the velocity's central difference), within what the transducer resolves:
 //!
 //! ```text
 //!   max x − min x over rows k−W … k  ≤  max(STICK_NOISE_MULTIPLE·√2·σ_x, q, STICK_FLOOR_M)
@@ -37,10 +37,6 @@ pub const STICK_NOISE_MULTIPLE: f64 = 4.0;
 /// position written in full precision. [m]
 pub const STICK_FLOOR_M: f64 = 1e-9;
 
-/// Rows before a row over which the piston must have stayed within the band to rest
-/// there: the span of the velocity's central difference in the cylinder relation. [1]
-pub const REST_WINDOW_ROWS: usize = 10;
-
 /// Relative rounding of a count scaled to metres and printed in decimal (~1e-12), with a
 /// wide margin: steps this close to a whole multiple of the smallest are counts. [1]
 const COUNT_ROUNDING: f64 = 1e-6;
@@ -70,18 +66,19 @@ pub struct Stick {
 }
 
 impl Stick {
-    /// The stick phases of the logged position `x`. [m]
-    pub fn of(x: &[f64]) -> Stick {
+    /// The stick phases of the logged position `x` [m], a row resting when the position
+    /// stayed within the band over the `window` rows before it.
+    pub fn of(x: &[f64], window: usize) -> Stick {
         let threshold_m = (STICK_NOISE_MULTIPLE * std::f64::consts::SQRT_2 * position_noise(x))
             .max(quantisation_step(x) * (1.0 + COUNT_ROUNDING))
             .max(STICK_FLOOR_M);
         let n = x.len();
         let rests: Vec<bool> = (0..n)
             .map(|k| {
-                if k < REST_WINDOW_ROWS {
+                if k < window {
                     return false;
                 }
-                let (lo, hi) = x[k - REST_WINDOW_ROWS..=k]
+                let (lo, hi) = x[k - window..=k]
                     .iter()
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
                         (l.min(*v), h.max(*v))
@@ -95,7 +92,7 @@ impl Stick {
             .into_iter()
             .filter_map(|run| {
                 let row = run.end - 1;
-                let last = row + REST_WINDOW_ROWS;
+                let last = row + window;
                 if last >= n || rests[run.end..=last].iter().any(|r| *r) {
                     return None;
                 }
@@ -174,6 +171,9 @@ mod tests {
     use super::*;
     use crate::diagnose::test_noise::gaussian;
 
+    /// The rest window of a 1 kHz log: twice the cylinder relation's five-row half-width.
+    const REST_ROWS: usize = 10;
+
     #[test]
     fn the_fourth_difference_median_reads_white_noise_under_a_swinging_payload() {
         // A 40 Hz swing of 0.2 mm (a second difference of ~13 µm per row at 1 kHz) with
@@ -206,7 +206,7 @@ mod tests {
                 }
             })
             .collect();
-        let s = Stick::of(&x);
+        let s = Stick::of(&x, REST_ROWS);
         assert!(s.rests[..10].iter().all(|r| !*r) && s.rests[10..100].iter().all(|r| *r));
         assert!(s.rests[100..].iter().all(|r| !*r));
         assert_eq!(s.breakaways, vec![Breakaway { row: 99, dir: 1.0 }]);
@@ -230,7 +230,7 @@ mod tests {
                 (exact / q).round() * q
             })
             .collect();
-        let s = Stick::of(&x);
+        let s = Stick::of(&x, REST_ROWS);
         // The swing's rounding reads as noise of a fraction of a count: the band is at
         // least a count and at most a few.
         assert!(

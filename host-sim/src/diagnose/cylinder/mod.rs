@@ -11,7 +11,7 @@
 //! solved for the logged port pressure p (the plant's [`Cylinder::drive_force`] gives
 //! everything but the inertia and the friction), o the port transducer's zero. Velocity
 //! and acceleration of a sliding row are central differences of the logged position over
-//! ±[`RATE_HALF_WIDTH`] rows; the rows where the piston rests and its breakaways are read
+//! ±[`RATE_HALF_WIDTH_S`]; the rows where the piston rests and its breakaways are read
 //! from the position by [`Stick`] (a backward-looking band at the transducer's resolution,
 //! so the last resting row before a breakaway keeps its full force).
 //!
@@ -61,8 +61,8 @@
 //! hold.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{Relation, Release, SENSOR_OFFSET_BAND_PA};
-use crate::diagnose::facts::{LogFacts, MOVING_PISTON_TRAVEL_M};
+use crate::diagnose::calibration::{Relation, Release, CORRELATION_BIN_S, SENSOR_OFFSET_BAND_PA};
+use crate::diagnose::facts::{rows_spanning, LogFacts, MOVING_PISTON_TRAVEL_M};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use crate::diagnose::mechanical::central_rate;
 use crate::diagnose::stick::Stick;
@@ -70,8 +70,9 @@ use plant_model::cylinder::Cylinder;
 use plant_model::Rig;
 use std::ops::Range;
 
-/// Rows on each side of the central differences of the position.
-pub const RATE_HALF_WIDTH: usize = 5;
+/// Time on each side of the central differences of the position (five rows of a 1 kHz
+/// log). [s]
+pub const RATE_HALF_WIDTH_S: f64 = 5e-3;
 
 /// Piston speed over which the Coulomb force's sign fades in. [m/s]
 pub const COULOMB_FADE_M_S: f64 = 1e-4;
@@ -131,8 +132,9 @@ impl<'a> CylinderRelation<'a> {
         rig: &'a Rig,
     ) -> Option<CylinderRelation<'a>> {
         let x = log.x_m.as_deref().filter(|_| facts.piston_moves)?;
-        let v = central_rate(&log.t_s, x, RATE_HALF_WIDTH);
-        let a = central_rate(&log.t_s, &v, RATE_HALF_WIDTH);
+        let h = rows_spanning(RATE_HALF_WIDTH_S, facts.period_s, 1);
+        let v = central_rate(&log.t_s, x, h);
+        let a = central_rate(&log.t_s, &v, h);
         Some(CylinderRelation {
             log,
             facts,
@@ -140,7 +142,7 @@ impl<'a> CylinderRelation<'a> {
             x,
             v,
             a,
-            stick: Stick::of(x),
+            stick: Stick::of(x, 2 * h),
         })
     }
 
@@ -328,6 +330,9 @@ pub fn breakaway_level(values: &[f64]) -> f64 {
 }
 
 impl Relation for CylinderRelation<'_> {
+    fn correlation_bin(&self) -> usize {
+        rows_spanning(CORRELATION_BIN_S, self.facts.period_s, 1)
+    }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         let c = &self.rig.cylinder;
         let nominal = c.coulomb_friction_n;
