@@ -22,7 +22,7 @@
 
 use crate::diagnose::angle_locked::{
     fit_line, line_gain, offset_from_line, plant_phase, LineEffect, LineFit, LineReading,
-    ShaftConstants,
+    ShaftConstants, OFFSET_HYPOTHESES,
 };
 use crate::diagnose::calibration::{
     hyd, mech, test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
@@ -302,10 +302,22 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         LineEffect::CurrentOffset => {
             let (off, label) = offset_from_line(f.amplitude, kt, f.coherent);
             let per_nm = off.abs() / a.max(f64::MIN_POSITIVE);
+            // Without the angle the line's phase cannot tell the sensor arrangement: the
+            // same line is a smaller offset behind a two-sensor Clarke transform.
+            let other = if f.coherent {
+                String::new()
+            } else {
+                let two = OFFSET_HYPOTHESES[3];
+                format!(
+                    "; the angle is not logged, so the arrangement is not seen: behind \
+                     two sensors the same line is {:+.3} A",
+                    off * OFFSET_HYPOTHESES[0].2 / two.2
+                )
+            };
             (
                 vec![("offset_a", off)],
                 OFFSET_BAND_A / per_nm.max(f64::MIN_POSITIVE),
-                format!("offset {off:+.3} A ({label})"),
+                format!("offset {off:+.3} A ({label}{other})"),
             )
         }
         LineEffect::FluxHarmonics => {
