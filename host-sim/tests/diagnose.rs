@@ -12,14 +12,12 @@ use serde_json::Value;
 use std::fs;
 use std::path::PathBuf;
 
-/// Simulates `scenario` with `effects` into `run.csv` in a fresh folder; the folder and
-/// the log.
-fn simulate(name: &str, scenario: &str, effects: Option<&str>) -> (PathBuf, PathBuf) {
-    simulate_with(name, scenario, effects, &["--log-rate", "1000"])
-}
+/// The log rate of every test here but the one on fast logs: the firmware's telemetry.
+const ONE_KHZ: &[&str] = &["--log-rate", "1000"];
 
-/// As [`simulate`], with the further arguments `extra` (a log rate, a duration).
-fn simulate_with(
+/// Simulates `scenario` with `effects` and the further arguments `extra` (a log rate, a
+/// duration) into `run.csv` in a fresh folder; the folder and the log.
+fn simulate(
     name: &str,
     scenario: &str,
     effects: Option<&str>,
@@ -45,19 +43,9 @@ fn simulate_with(
     (dir, log)
 }
 
-/// Simulates `scenario` with `effects` into a log in a fresh folder, then diagnoses it.
-fn diagnose(name: &str, scenario: &str, effects: Option<&str>) -> (Value, PathBuf) {
-    diagnose_with(name, scenario, effects, &["--log-rate", "1000"])
-}
-
-/// As [`diagnose`], the log simulated with the further arguments `extra`.
-fn diagnose_with(
-    name: &str,
-    scenario: &str,
-    effects: Option<&str>,
-    extra: &[&str],
-) -> (Value, PathBuf) {
-    let (dir, log) = simulate_with(name, scenario, effects, extra);
+/// Simulates as [`simulate`] into a log in a fresh folder, then diagnoses it.
+fn diagnose(name: &str, scenario: &str, effects: Option<&str>, extra: &[&str]) -> (Value, PathBuf) {
+    let (dir, log) = simulate(name, scenario, effects, extra);
     let json = dir.join("diagnosis.json");
     let report = dir.join("report");
     let o = eha(&[
@@ -96,7 +84,7 @@ fn gain(v: &Value, signal: &str) -> f64 {
 
 #[test]
 fn a_nominal_rig_is_explained_by_the_nominal_model() {
-    let (v, report) = diagnose("nominal", "pressure-hold", None);
+    let (v, report) = diagnose("nominal", "pressure-hold", None, ONE_KHZ);
     assert_eq!(lead(&v), "none", "{v:#}");
     assert!(v["extended"]["effects"].as_array().unwrap().is_empty());
     // The contract's fields.
@@ -155,8 +143,8 @@ fn a_ten_kilohertz_log_is_read_as_a_one_kilohertz_log_is() {
     // controller updates at 2 kHz and the 10 kHz log holds for five rows, so its
     // second differences understate its noise.
     let run = |rate: &'static str| ["--log-rate", rate, "--duration", "6"];
-    let (slow, _) = diagnose_with("nominal-1khz", "pressure-step", None, &run("1000"));
-    let (fast, _) = diagnose_with("nominal-10khz", "pressure-step", None, &run("10000"));
+    let (slow, _) = diagnose("nominal-1khz", "pressure-step", None, &run("1000"));
+    let (fast, _) = diagnose("nominal-10khz", "pressure-step", None, &run("10000"));
     assert_eq!(lead(&fast), "none", "{fast:#}");
     for signal in ["p_pa", "iq_a", "speed_rad_s", "ud_v", "uq_v"] {
         let (a, b) = (
@@ -169,7 +157,7 @@ fn a_ten_kilohertz_log_is_read_as_a_one_kilohertz_log_is() {
         );
     }
     let leak = Some("extra_leakage:coefficient_m3_s_pa=5e-13");
-    let (v, _) = diagnose_with("leakage-10khz", "pressure-step", leak, &run("10000"));
+    let (v, _) = diagnose("leakage-10khz", "pressure-step", leak, &run("10000"));
     assert_eq!(lead(&v), "extra_leakage", "{v:#}");
     let c = param(&v, "coefficient_m3_s_pa");
     assert!((c / 5e-13 - 1.0).abs() < 0.2, "{c}");
@@ -182,6 +170,7 @@ fn an_inverter_dead_time_is_named_and_measured() {
         "dead-time",
         "pressure-hold",
         Some("dead_time:dead_time_s=1.5e-6"),
+        ONE_KHZ,
     );
     assert_eq!(lead(&v), "dead_time", "{v:#}");
     let t_d = param(&v, "dead_time_s");
@@ -200,6 +189,7 @@ fn a_gas_loss_in_the_absorber_is_named_and_measured() {
         "precharge",
         "pressure-step",
         Some("accumulator_precharge:precharge_pa=1.8e6"),
+        ONE_KHZ,
     );
     assert_eq!(lead(&v), "accumulator_precharge", "{v:#}");
     let p0 = param(&v, "precharge_pa");
@@ -223,6 +213,7 @@ fn a_transducer_lag_shows_as_its_phase_delay_at_the_payload_resonance() {
         "lag-signature",
         "speed-step",
         Some("pressure_sensor_lag:time_constant_s=7e-3"),
+        ONE_KHZ,
     );
     let bench = host_sim::bench_log::read(&log).expect("the simulated log reads back");
     let a = host_sim::diagnose::analysis::analyse(&bench, &plant_model::Rig::nominal())

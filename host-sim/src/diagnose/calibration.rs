@@ -29,6 +29,7 @@
 //! The relations themselves live beside: [`super::hydraulic_relation`] and
 //! [`super::mechanical_relation`] (the electrical and cylinder ones in their own modules).
 
+use crate::diagnose::facts::{rows_spanning, LogFacts};
 use crate::diagnose::least_squares::{
     fit_with_patience, variance_per_independent_sample, Fitted, ParamSpec, PATIENCE,
 };
@@ -70,9 +71,10 @@ pub enum Release {
     CylinderFriction,
 }
 
-/// `windows` thinned to at most `max_rows` rows together ([`MAX_FIT_S`] of the log): half of the budget to the
-/// windows where `signal` moves most (its range within the window: the steps, fills and
-/// starts where the effects show), the rest spread evenly over the others, in time order.
+/// `windows` thinned to at most `max_rows` rows together ([`MAX_FIT_S`] of the log): half
+/// of the budget to the windows where `signal` moves most (its range within the window:
+/// the steps, fills and starts where the effects show), the rest spread evenly over the
+/// others, in time order.
 pub fn thinned(windows: Vec<Range<usize>>, signal: &[f64], max_rows: usize) -> Vec<Range<usize>> {
     let rows: usize = windows.iter().map(|w| w.len()).sum();
     if rows <= max_rows {
@@ -125,9 +127,13 @@ pub trait Relation: Sync {
     fn patience(&self) -> usize {
         PATIENCE
     }
+    /// The facts of the log the relation reads.
+    fn facts(&self) -> &LogFacts;
     /// Rows whose residuals are averaged before their correlation time is read
     /// ([`variance_per_independent_sample`]): [`CORRELATION_BIN_S`] of the log.
-    fn correlation_bin(&self) -> usize;
+    fn correlation_bin(&self) -> usize {
+        rows_spanning(CORRELATION_BIN_S, self.facts().period_s, 1)
+    }
 }
 
 /// Span of the blocks a relation's residuals are averaged over before their correlation
@@ -161,8 +167,8 @@ impl<R: Relation> Relation for Patient<'_, R> {
     fn patience(&self) -> usize {
         self.patience
     }
-    fn correlation_bin(&self) -> usize {
-        self.relation.correlation_bin()
+    fn facts(&self) -> &LogFacts {
+        self.relation.facts()
     }
 }
 
@@ -196,8 +202,8 @@ impl<R: Relation> Relation for Pinned<'_, R> {
     fn patience(&self) -> usize {
         self.relation.patience()
     }
-    fn correlation_bin(&self) -> usize {
-        self.relation.correlation_bin()
+    fn facts(&self) -> &LogFacts {
+        self.relation.facts()
     }
 }
 

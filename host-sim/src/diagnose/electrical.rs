@@ -15,7 +15,7 @@
 
 use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::back_emf::Stator;
-use crate::diagnose::calibration::{Relation, Release, CORRELATION_BIN_S};
+use crate::diagnose::calibration::{Relation, Release};
 use crate::diagnose::facts::{rows_spanning, LogFacts};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
@@ -129,8 +129,8 @@ impl<'a> ElectricalRelation<'a> {
 }
 
 impl Relation for ElectricalRelation<'_> {
-    fn correlation_bin(&self) -> usize {
-        rows_spanning(CORRELATION_BIN_S, self.facts.period_s, 1)
+    fn facts(&self) -> &LogFacts {
+        self.facts
     }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         let m = &self.rig.motor;

@@ -4,8 +4,8 @@
 //! windows in noise units.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{scaled, Relation, Release, CORRELATION_BIN_S};
-use crate::diagnose::facts::{rows_spanning, LogFacts};
+use crate::diagnose::calibration::{scaled, Relation, Release};
+use crate::diagnose::facts::LogFacts;
 use crate::diagnose::hydraulic::{HydraulicInputs, HydraulicParams, Hydraulics};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use plant_model::accumulator::GasCharge;
@@ -188,8 +188,8 @@ pub struct HydraulicRelation<'a> {
 }
 
 impl Relation for HydraulicRelation<'_> {
-    fn correlation_bin(&self) -> usize {
-        rows_spanning(CORRELATION_BIN_S, self.facts.period_s, 1)
+    fn facts(&self) -> &LogFacts {
+        self.facts
     }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         hydraulic_specs(self.rig, release)

@@ -3,8 +3,8 @@
 //! angle-locked line basis it carries along, and its residuals over the windows.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{Relation, Release, CORRELATION_BIN_S};
-use crate::diagnose::facts::{rows_spanning, LogFacts};
+use crate::diagnose::calibration::{Relation, Release};
+use crate::diagnose::facts::LogFacts;
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use crate::diagnose::mechanical::{MechanicalParams, Mechanics, ShaftMotion};
 use nalgebra::{DMatrix, DVector};
@@ -195,8 +195,8 @@ impl<'a> MechanicalRelation<'a> {
 }
 
 impl Relation for MechanicalRelation<'_> {
-    fn correlation_bin(&self) -> usize {
-        rows_spanning(CORRELATION_BIN_S, self.facts.period_s, 1)
+    fn facts(&self) -> &LogFacts {
+        self.facts
     }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         mechanical_specs(self.rig, release)

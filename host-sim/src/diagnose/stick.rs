@@ -2,7 +2,8 @@
 //! friction model (`plant_model::friction`) read from the position column.
 //!
 //! A stuck piston does not move at all, so a row rests when the position stayed, over it
-//! and the `window` rows before it (the span of the velocity's central difference), within what the transducer resolves:
+//! and the `window` rows before it (the span of the velocity's central difference), within
+//! what the transducer resolves:
 //!
 //! ```text
 //!   max x − min x over rows k−W … k  ≤  max(STICK_NOISE_MULTIPLE·√2·σ_x, q, STICK_FLOOR_M)

@@ -61,7 +61,7 @@
 //! hold.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{Relation, Release, CORRELATION_BIN_S, SENSOR_OFFSET_BAND_PA};
+use crate::diagnose::calibration::{Relation, Release, SENSOR_OFFSET_BAND_PA};
 use crate::diagnose::facts::{rows_spanning, LogFacts, MOVING_PISTON_TRAVEL_M};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use crate::diagnose::mechanical::central_rate;
@@ -330,8 +330,8 @@ pub fn breakaway_level(values: &[f64]) -> f64 {
 }
 
 impl Relation for CylinderRelation<'_> {
-    fn correlation_bin(&self) -> usize {
-        rows_spanning(CORRELATION_BIN_S, self.facts.period_s, 1)
+    fn facts(&self) -> &LogFacts {
+        self.facts
     }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         let c = &self.rig.cylinder;
