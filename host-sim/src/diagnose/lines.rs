@@ -19,6 +19,8 @@
 use crate::bench_log::BenchLog;
 use crate::diagnose::facts::{LogFacts, SteadyWindow};
 use nalgebra::{DMatrix, DVector};
+use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
+use plant_model::Rig;
 use rustfft::num_complex::Complex64;
 
 /// Neighbouring orders on each side of a line whose amplitudes measure its noise floor.
@@ -40,7 +42,7 @@ pub struct WindowLines {
 }
 
 /// The lines at one order in one window.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct OrderLines {
     /// Cycles per revolution.
     pub order: u32,
@@ -56,6 +58,9 @@ pub struct OrderLines {
     pub torque: Complex64,
     /// Commanded d and q voltages, when logged. [V]
     pub voltages: Option<[Complex64; 2]>,
+    /// The d and q lines of the dead-time voltage the logged currents make, per fade band
+    /// of [`DEAD_TIME_BANDS_A`] at [`REFERENCE_DEAD_TIME_S`] (empty without the angle). [V]
+    pub dead_time_voltages: Vec<[Complex64; 2]>,
 }
 
 impl WindowLines {
@@ -93,6 +98,51 @@ impl WindowLines {
     }
 }
 
+/// Dead time the dead-time voltage lines are computed for (they scale with it). [s]
+pub const REFERENCE_DEAD_TIME_S: f64 = 1e-6;
+
+/// Current bands of the dead-time error's fade tried (the rig contract does not give it). [A]
+pub const DEAD_TIME_BANDS_A: [f64; 7] = [0.01, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8];
+
+/// The d and q dead-time voltage over `rows` per fade band of [`DEAD_TIME_BANDS_A`], at
+/// [`REFERENCE_DEAD_TIME_S`]: the logged d-q currents turned into phase currents at the
+/// electrical angle p_n·θ, each leg's error −t_d·f_pwm·U_dc·sat(i/band) (the plant's
+/// [`Inverter`]) turned back into d-q. Read from the currents that flowed, not from their
+/// mean: the current line the dead time causes moves the phase currents' zero crossings,
+/// and with them the voltage it makes. The logged DC link is used where present. [V]
+pub fn dead_time_voltage(
+    log: &BenchLog,
+    facts: &LogFacts,
+    rig: &Rig,
+    rows: std::ops::Range<usize>,
+) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let pp = rig.motor.pole_pairs as f64;
+    DEAD_TIME_BANDS_A
+        .iter()
+        .map(|&band| {
+            let mut p = rig.inverter.clone();
+            p.dead_time_s = REFERENCE_DEAD_TIME_S;
+            p.dead_time_current_band_a = band;
+            let mut inv = Inverter::new(&p);
+            let (mut d, mut q) = (
+                Vec::with_capacity(rows.len()),
+                Vec::with_capacity(rows.len()),
+            );
+            for k in rows.clone() {
+                if let Some(u) = log.udc_v.as_deref() {
+                    inv.set_u_dc(u[k]);
+                }
+                let (s, c) = (pp * facts.theta_rad[k]).sin_cos();
+                let i = dq_to_abc(log.id_a[k], log.iq_a[k], s, c);
+                let (ud, uq) = pole_to_dq(&inv.pole_voltages(&[0.0; 3], &i), s, c);
+                d.push(ud);
+                q.push(uq);
+            }
+            (d, q)
+        })
+        .collect()
+}
+
 /// The orders to analyse: each candidate and its neighbours, without order 0 and above the
 /// window's Nyquist order.
 fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
@@ -106,7 +156,8 @@ fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
     v
 }
 
-/// Complex amplitudes of `signals` at `orders` over `rows`, by one least-squares fit of a
+/// Complex amplitudes of `signals` at `orders` over `rows` (each signal a slice whose first
+/// element is the log's row given beside it), by one least-squares fit of a
 /// mean, a slope and sin/cos of k·θ for every order (the orders are near-orthogonal over
 /// whole revolutions; fitting them together removes what leaks between them).
 fn lock_in(
@@ -114,7 +165,7 @@ fn lock_in(
     theta: &[f64],
     rows: std::ops::Range<usize>,
     orders: &[u32],
-    signals: &[&[f64]],
+    signals: &[(&[f64], usize)],
 ) -> Option<Vec<Vec<Complex64>>> {
     let n = rows.len();
     let cols = 2 + 2 * orders.len();
@@ -142,8 +193,11 @@ fn lock_in(
     let svd = a.svd(true, true);
     signals
         .iter()
-        .map(|y| {
-            let b = DVector::from_iterator(n, y[rows.clone()].iter().copied());
+        .map(|(y, offset)| {
+            let b = DVector::from_iterator(
+                n,
+                y[rows.start - offset..rows.end - offset].iter().copied(),
+            );
             let x = svd.solve(&b, 1e-12).ok()?;
             Some(
                 (0..orders.len())
@@ -159,6 +213,7 @@ fn lock_in(
 pub fn window_lines(
     log: &BenchLog,
     facts: &LogFacts,
+    rig: &Rig,
     candidates: &[u32],
     kt: f64,
     j: f64,
@@ -189,10 +244,22 @@ pub fn window_lines(
                 }
                 v
             };
-            let mut signals: Vec<&[f64]> = vec![&log.iq_a, &log.id_a, &trend, &log.p_pa];
+            let mut signals: Vec<(&[f64], usize)> =
+                vec![(&log.iq_a, 0), (&log.id_a, 0), (&trend, 0), (&log.p_pa, 0)];
             let voltages = log.ud_v.as_deref().zip(log.uq_v.as_deref());
             if let Some((ud, uq)) = voltages {
-                signals.extend([ud, uq]);
+                signals.extend([(ud, 0), (uq, 0)]);
+            }
+            // The inverter's dead-time voltage the logged currents make, per fade band
+            // ([`dead_time_voltage`]): only where the angle places the phases.
+            let dead_time = if facts.angle_logged {
+                dead_time_voltage(log, facts, rig, rows.clone())
+            } else {
+                Vec::new()
+            };
+            let first_dead = signals.len();
+            for (d, q) in &dead_time {
+                signals.extend([(d.as_slice(), rows.start), (q.as_slice(), rows.start)]);
             }
             let z = lock_in(t, theta, rows.clone(), &orders, &signals)?;
             let lines = orders
@@ -209,6 +276,9 @@ pub fn window_lines(
                         p,
                         torque: iq * kt + th * (j * wk * wk) - p * d_per_rad,
                         voltages: voltages.map(|_| [z[4][m], z[5][m]]),
+                        dead_time_voltages: (0..dead_time.len())
+                            .map(|b| [z[first_dead + 2 * b][m], z[first_dead + 2 * b + 1][m]])
+                            .collect(),
                     }
                 })
                 .collect();
@@ -240,7 +310,7 @@ mod tests {
             .zip(&t)
             .map(|(a, t)| 0.3 * (18.0 * a - 0.7).cos() + 2.0 * t)
             .collect();
-        let z = lock_in(&t, &th, 0..n, &[17, 18, 19], &[&y]).unwrap();
+        let z = lock_in(&t, &th, 0..n, &[17, 18, 19], &[(&y, 0)]).unwrap();
         let want = Complex64::from_polar(0.3, -0.7);
         assert!((z[0][1] - want).norm() < 1e-9, "{:?}", z[0][1]);
         assert!(z[0][0].norm() < 1e-9 && z[0][2].norm() < 1e-9);
