@@ -22,6 +22,7 @@ pub mod controller;
 pub mod current_loop;
 pub mod encoder;
 pub mod io;
+pub mod liveness;
 pub mod param_store;
 pub mod parameters;
 pub mod pi;
