@@ -13,6 +13,7 @@
 #![cfg_attr(not(test), no_std)]
 
 pub mod angle_grid;
+pub mod bridge;
 pub mod can_protocol;
 pub mod can_server;
 pub mod commissioning;
