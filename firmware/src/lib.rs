@@ -33,6 +33,7 @@ pub mod scaling;
 pub mod shunt;
 pub mod speed_loop;
 pub mod speed_observer;
+pub mod stack;
 pub mod step_test;
 pub mod supervisor;
 pub mod svpwm;
