@@ -2,8 +2,8 @@
 //! machine too:
 //!
 //! 1. what it needs installed when missing ([`setup`]): the `thumbv7em-none-eabihf` target
-//!    (rustup), `qemu-system-arm` and `tmux` (apt-get), Python's `cantools` (a virtual
-//!    environment);
+//!    (rustup), the `flip-link` linker (cargo install), `qemu-system-arm` and `tmux`
+//!    (apt-get), Python's `cantools` (a virtual environment);
 //! 2. `cargo fmt --check` and `cargo clippy --workspace --all-targets -D warnings`;
 //! 3. the host tests of the whole workspace;
 //! 4. the CAN DBC file: in sync with `firmware::can_protocol` ([`dbc`]), and cantools
@@ -90,7 +90,9 @@ fn run(step: &str, cmd: &mut Command) -> Result<()> {
     Ok(())
 }
 
+/// The Cortex-M4F target and the linker its images use (flip-link).
 fn ensure_target() -> Result<()> {
+    setup::linker()?;
     let out = Command::new("rustup")
         .args(["target", "list", "--installed"])
         .output()
