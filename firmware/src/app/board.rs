@@ -336,10 +336,6 @@ pub fn init(pwm_hz: u32, cfg: &Config, node: NodeId) -> Board {
     // interrupt runs below it.
     interrupt::FDCAN1_IT0.set_priority(Priority::P3);
     interrupt::FDCAN1_IT1.set_priority(Priority::P3);
-    // The comparators' interrupt (enabled by their driver) is not used: its handler would
-    // mask the EXTI lines that latch the break sources.
-    interrupt::COMP1_2_3.disable();
-    interrupt::COMP4_5_6.disable();
     interrupt::TIM1_BRK_TIM15.set_priority(Priority::P2);
 
     // The driver panics on a single-bank part; check the option bit first.
@@ -573,6 +569,10 @@ pub fn clear_break_flags() {
 /// gate driver's fault line falling (PB12 on EXTI line 12, falling edge). The lines are
 /// unmasked so the pending bits are set; their interrupts stay disabled in the NVIC.
 fn latch_break_sources() {
+    // The comparators' interrupt (enabled by their driver) is not used: its handler would
+    // mask the EXTI lines that latch the break sources. Off before the lines are unmasked.
+    interrupt::COMP1_2_3.disable();
+    interrupt::COMP4_5_6.disable();
     // SYSCFG_EXTICR4 selects the port of lines 12‥15; line 12 is its first field.
     pac::SYSCFG
         .exticr(3)
