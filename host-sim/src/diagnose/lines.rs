@@ -156,9 +156,15 @@ fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
     v
 }
 
+/// Terms of the polynomial in time fitted beside the lines: a cubic. A window's speed is
+/// steady only within a band (a sine test's shaft accelerates through it), and the angle's
+/// curvature left by a straight line would leak into the lines, most at the high orders
+/// whose torque weighs the angle's line with J·(k·ω̄)².
+const TREND_TERMS: usize = 4;
+
 /// Complex amplitudes of `signals` at `orders` over `rows` (each signal a slice whose first
 /// element is the log's row given beside it), by one least-squares fit of a
-/// mean, a slope and sin/cos of k·θ for every order (the orders are near-orthogonal over
+/// cubic in time ([`TREND_TERMS`]) and sin/cos of k·θ for every order (the orders are near-orthogonal over
 /// whole revolutions; fitting them together removes what leaks between them).
 fn lock_in(
     t: &[f64],
@@ -168,7 +174,7 @@ fn lock_in(
     signals: &[(&[f64], usize)],
 ) -> Option<Vec<Vec<Complex64>>> {
     let n = rows.len();
-    let cols = 2 + 2 * orders.len();
+    let cols = TREND_TERMS + 2 * orders.len();
     if n < 2 * cols {
         return None;
     }
@@ -176,18 +182,22 @@ fn lock_in(
     let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
     let a = DMatrix::from_fn(n, cols, |i, j| {
         let k = rows.start + i;
-        match j {
-            0 => 1.0,
-            1 => (t[k] - t0) / span - 0.5,
-            _ => {
-                let order = orders[(j - 2) / 2] as f64;
-                let x = order * theta[k];
-                if (j - 2) % 2 == 0 {
-                    x.cos()
-                } else {
-                    x.sin()
-                }
-            }
+        if j < TREND_TERMS {
+            // Legendre polynomials of the window's time on [−1, 1]: well conditioned.
+            let x = 2.0 * (t[k] - t0) / span - 1.0;
+            return match j {
+                0 => 1.0,
+                1 => x,
+                2 => 1.5 * x * x - 0.5,
+                _ => 2.5 * x * x * x - 1.5 * x,
+            };
+        }
+        let order = orders[(j - TREND_TERMS) / 2] as f64;
+        let x = order * theta[k];
+        if (j - TREND_TERMS) % 2 == 0 {
+            x.cos()
+        } else {
+            x.sin()
         }
     });
     let svd = a.svd(true, true);
@@ -201,7 +211,7 @@ fn lock_in(
             let x = svd.solve(&b, 1e-12).ok()?;
             Some(
                 (0..orders.len())
-                    .map(|m| Complex64::new(x[2 + 2 * m], -x[3 + 2 * m]))
+                    .map(|m| Complex64::new(x[TREND_TERMS + 2 * m], -x[TREND_TERMS + 1 + 2 * m]))
                     .collect(),
             )
         })
