@@ -14,9 +14,9 @@
 //! diagnose` and `eha tune`; re-capturing (or cutting the log at the reset) is the fix.
 
 use crate::bench_log::limits::{
-    line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS,
+    line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS, MIN_SAMPLE_INTERVAL_S,
 };
-use crate::bench_log::{self, BenchLog, Signal, MIN_ROWS};
+use crate::bench_log::{self, time_problem, BenchLog, Problem, Signal, MIN_ROWS};
 use crate::output::paths::Declared;
 use crate::output::CliError;
 use clap::Args;
@@ -70,6 +70,14 @@ pub enum LineProblem {
         /// This frame's time. [s]
         value: f64,
     },
+    /// The frame follows the previous one closer in time than any sampler logs
+    /// ([`MIN_SAMPLE_INTERVAL_S`]).
+    IntervalTooShort {
+        /// The previous frame's time. [s]
+        previous: f64,
+        /// This frame's time. [s]
+        value: f64,
+    },
 }
 
 impl fmt::Display for LineProblem {
@@ -89,6 +97,12 @@ impl fmt::Display for LineProblem {
                 f,
                 "field `t_s`: time {value} s does not exceed the previous frame's {previous} s \
                  (controller reset?)"
+            ),
+            LineProblem::IntervalTooShort { previous, value } => write!(
+                f,
+                "field `t_s`: time {value} s follows the previous frame's {previous} s by \
+                 {:.3e} s; no sampler logs frames less than {MIN_SAMPLE_INTERVAL_S:e} s apart",
+                value - previous
             ),
         }
     }
@@ -284,11 +298,15 @@ impl LineReader {
         if let Some((k, v)) = out_of_range_field(&frame) {
             return Line::Malformed(LineProblem::OutOfRange(k, v));
         }
-        if let Some(previous) = self.last_t.filter(|p| frame.t_s <= *p) {
-            return Line::Malformed(LineProblem::TimeNotIncreasing {
-                previous,
-                value: frame.t_s,
-            });
+        let value = frame.t_s;
+        match self.last_t.and_then(|p| Some((p, time_problem(p, value)?))) {
+            Some((previous, Problem::TimeNotIncreasing { .. })) => {
+                return Line::Malformed(LineProblem::TimeNotIncreasing { previous, value })
+            }
+            Some((previous, _)) => {
+                return Line::Malformed(LineProblem::IntervalTooShort { previous, value })
+            }
+            None => {}
         }
         self.last_t = Some(frame.t_s);
         Line::Frame(frame)

@@ -679,3 +679,92 @@ fn an_interrupted_run_leaves_nothing_behind() {
         "no report, JSON, staging or temporary file"
     );
 }
+
+/// A bench log of `rows` rows of a 5 MPa hold whose times are `t(i)`, with `meta` before
+/// the header.
+fn hold_rows(meta: &str, rows: usize, t: impl Fn(usize) -> f64) -> String {
+    let mut text = String::from(meta);
+    text.push_str("t_s,p_ref_pa,p_pa,speed_rad_s,iq_a,id_a\n");
+    for i in 0..rows {
+        text.push_str(&format!("{:?},5e6,{},5.86,0.4,0\n", t(i), 5e6 + i as f64));
+    }
+    text
+}
+
+#[test]
+fn a_time_axis_no_sampler_makes_is_refused_naming_the_row() {
+    let dir = scratch("time-axis");
+    // Steps of one float ulp at 1 s (2.2e-16 s): increasing, but no sampler's.
+    let ulps = dir.join("ulps.csv");
+    fs::write(&ulps, hold_rows("", 150, |i| 1.0 + i as f64 * 2.3e-16)).unwrap();
+    let json = dir.join("d.json");
+    let err = refused(
+        &["diagnose", s(&ulps), "--json", s(&json)],
+        &["ulps.csv", "line 3", "t_s", "1e-6 s apart"],
+    );
+    assert!(err.contains("2.220e-16 s"), "the step said: {err}");
+    assert!(!json.exists());
+    // One short step among 1 kHz rows is named where it is (header line 1, row k at k + 2).
+    let glitch = dir.join("glitch.csv");
+    let t = |i: usize| {
+        if i == 60 {
+            0.059 + 1e-9
+        } else {
+            i as f64 * 1e-3
+        }
+    };
+    fs::write(&glitch, hold_rows("", 150, t)).unwrap();
+    refused(
+        &["tune", s(&glitch), "--loop", "pressure"],
+        &["line 62", "t_s", "1e-6 s apart"],
+    );
+    // The same rule for telemetry.
+    let mut lines = String::new();
+    for i in 0..150 {
+        lines.push_str(&format!(
+            "EHA1 t_s={:?} p_ref_pa=5000000 p_pa=5000000 speed_rad_s=6 iq_a=0.5 id_a=0 theta_m_rad=1 speed_ref_rad_s=6 iq_ref_a=0.5 ud_v=0 uq_v=1 udc_v=280 mode=3 fault=0 status=0\n",
+            1.0 + i as f64 * 2.3e-16
+        ));
+    }
+    let telemetry = dir.join("telemetry.log");
+    fs::write(&telemetry, lines).unwrap();
+    let out = dir.join("ingested.csv");
+    refused(
+        &["ingest", s(&telemetry), "--out", s(&out)],
+        &["telemetry.log:2", "t_s", "1e-6 s apart"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn metadata_beyond_a_header_is_refused_naming_the_line() {
+    let dir = scratch("metadata");
+    // Ten thousand lines are a header still; one more is not.
+    let lines = |n: usize| {
+        (0..n)
+            .map(|k| format!("# key{k}: value\n"))
+            .collect::<String>()
+    };
+    let many = dir.join("many.csv");
+    fs::write(&many, hold_rows(&lines(10_001), 150, |i| i as f64 * 1e-3)).unwrap();
+    let err = refused(
+        &["tune", s(&many), "--loop", "pressure"],
+        &["many.csv", "line 10001"],
+    );
+    assert!(err.contains("10000 metadata lines"), "{err}");
+    let fine = dir.join("fine.csv");
+    fs::write(&fine, hold_rows(&lines(10_000), 150, |i| i as f64 * 1e-3)).unwrap();
+    let err = refused(
+        &["tune", s(&fine), "--loop", "pressure"],
+        &["no pressure setpoint step"],
+    );
+    assert!(!err.contains("metadata"), "{err}");
+    // Twenty lines of 60 kB each are more bytes than a header holds (1 MiB).
+    let long = format!("# note: {}\n", "x".repeat(60_000)).repeat(20);
+    let bulky = dir.join("bulky.csv");
+    fs::write(&bulky, hold_rows(&long, 150, |i| i as f64 * 1e-3)).unwrap();
+    refused(
+        &["tune", s(&bulky), "--loop", "pressure"],
+        &["bulky.csv", "line 18", "bytes of metadata"],
+    );
+}

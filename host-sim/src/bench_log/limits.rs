@@ -1,7 +1,9 @@
 //! What keeps reading a bench log bounded in memory and its messages readable, whatever the
 //! file holds: a longest line ([`MAX_LINE_BYTES`], enforced below the CSV reader so a file
 //! without line breaks is refused after that many bytes, not after filling the memory), a
-//! most rows ([`MAX_ROWS`]), the physical range of each column ([`physical_range`]), and
+//! most rows ([`MAX_ROWS`]), a most metadata lines and bytes ([`MAX_METADATA_LINES`],
+//! [`MAX_METADATA_BYTES`]), the physical range of each column ([`physical_range`]), the
+//! shortest interval between two rows a sampler makes ([`MIN_SAMPLE_INTERVAL_S`]), and
 //! excerpts of offending fields instead of the fields whole ([`excerpt`]).
 
 use super::Signal;
@@ -14,6 +16,20 @@ pub const MAX_LINE_BYTES: usize = 64 * 1024;
 /// The most data rows a bench log may have: ten minutes at 10 kHz is 6 million, the
 /// contract's largest typical log; every row costs up to 120 bytes of memory read.
 pub const MAX_ROWS: usize = 10_000_000;
+
+/// The most `# key: value` lines a bench log may carry: a logger's header of its
+/// configuration is tens to hundreds of lines; beyond this the lines are data, not a header.
+pub const MAX_METADATA_LINES: usize = 10_000;
+
+/// The most bytes the metadata's keys and values may hold together (each line up to
+/// [`MAX_LINE_BYTES`], but not ten thousand of those). [bytes]
+pub const MAX_METADATA_BYTES: usize = 1 << 20;
+
+/// The shortest interval between two rows: no sampler of an actuator's signals logs faster
+/// than 1 MHz (the drive's telemetry comes at most at its 20 kHz PWM rate, a laboratory
+/// data logger at a few hundred kHz). Shorter steps are a time column in other units than
+/// seconds, or times printed with too few digits for the rate. [s]
+pub const MIN_SAMPLE_INTERVAL_S: f64 = 1e-6;
 
 /// Characters of an offending field quoted in a message.
 const EXCERPT_CHARS: usize = 40;

@@ -11,8 +11,10 @@
 //! unread (a rig's logger may add a text column); unknown metadata keys are kept.
 //!
 //! Beyond the contract, for bounded memory and arithmetic: a line longer than
-//! [`limits::MAX_LINE_BYTES`], more than [`limits::MAX_ROWS`] rows, or a value outside its
-//! column's physical range ([`limits::physical_range`]) is refused the same way.
+//! [`limits::MAX_LINE_BYTES`], more than [`limits::MAX_ROWS`] rows, more metadata than
+//! [`limits::MAX_METADATA_LINES`] lines or [`limits::MAX_METADATA_BYTES`] bytes, a value
+//! outside its column's physical range ([`limits::physical_range`]), or two rows closer in
+//! time than any sampler logs ([`limits::MIN_SAMPLE_INTERVAL_S`]) is refused the same way.
 //!
 //! The writer checks the same rules first (so every file it writes reads back), writes the
 //! values in shortest round-trip notation and replaces the target atomically
@@ -21,7 +23,10 @@
 pub mod limits;
 pub mod replayable;
 
-use limits::{excerpt, line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS};
+use limits::{
+    excerpt, line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_METADATA_BYTES,
+    MAX_METADATA_LINES, MAX_ROWS, MIN_SAMPLE_INTERVAL_S,
+};
 use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Write};
@@ -266,9 +271,14 @@ impl BenchLog {
             column: column.to_string(),
             problem,
         };
+        let mut bytes = 0usize;
         for (i, (k, v)) in self.metadata.iter().enumerate() {
             if !metadata_fits(k, v) {
                 return Err(content(i + 1, k, Problem::BadMetadata));
+            }
+            bytes += k.len() + v.len();
+            if i >= MAX_METADATA_LINES || bytes > MAX_METADATA_BYTES {
+                return Err(content(i + 1, k, Problem::TooMuchMetadata));
             }
         }
         let header_line = self.metadata.len() + 1;
@@ -304,15 +314,9 @@ impl BenchLog {
                 Problem::TooManyRows,
             ));
         }
-        if let Some(i) = self.t_s.windows(2).position(|w| w[1] <= w[0]) {
-            return Err(content(
-                header_line + 2 + i,
-                Signal::Time.name(),
-                Problem::TimeNotIncreasing {
-                    previous: self.t_s[i],
-                    value: self.t_s[i + 1],
-                },
-            ));
+        let mut steps = self.t_s.windows(2).enumerate();
+        if let Some((i, problem)) = steps.find_map(|(i, w)| Some((i, time_problem(w[0], w[1])?))) {
+            return Err(content(header_line + 2 + i, Signal::Time.name(), problem));
         }
         if rows < MIN_ROWS {
             return Err(content(
@@ -380,6 +384,25 @@ pub enum Problem {
         /// This row's time. [s]
         value: f64,
     },
+    /// Two rows closer in time than any sampler logs.
+    #[error(
+        "time {value} s follows the previous row's {previous} s by {:.3e} s; no sampler logs \
+         rows less than {MIN_SAMPLE_INTERVAL_S:e} s apart (is t_s in seconds, printed with \
+         enough digits?)",
+        value - previous
+    )]
+    IntervalTooShort {
+        /// The previous row's time. [s]
+        previous: f64,
+        /// This row's time. [s]
+        value: f64,
+    },
+    /// More metadata than a bench log's header holds.
+    #[error(
+        "more than {MAX_METADATA_LINES} metadata lines or {MAX_METADATA_BYTES} bytes of \
+         metadata; a bench log's `# key: value` lines are a short header"
+    )]
+    TooMuchMetadata,
     /// The log is too short.
     #[error("only {rows} data rows; a bench log needs at least {MIN_ROWS}")]
     TooFewRows {
@@ -506,6 +529,7 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     // Metadata and blank lines before the header; the CSV reader takes over at the first
     // other line, so its line numbers are offset by the lines consumed here.
     let mut consumed = 0usize;
+    let mut metadata_bytes = 0usize;
     let mut line = String::new();
     loop {
         let buf = input.fill_buf().map_err(io_err)?;
@@ -537,6 +561,10 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
             // the value) is refused here too, so every log read can be written.
             if !metadata_fits(k, v) {
                 return Err(err(consumed, k, Problem::BadMetadata));
+            }
+            metadata_bytes += k.len() + v.len();
+            if log.metadata.len() == MAX_METADATA_LINES || metadata_bytes > MAX_METADATA_BYTES {
+                return Err(err(consumed, k, Problem::TooMuchMetadata));
             }
             log.metadata.push((k.to_string(), v.to_string()));
         }
@@ -645,14 +673,8 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
                 return Err(err(line, s.name(), beyond(s, v)));
             }
             if s == Signal::Time {
-                if let Some(&previous) = log.t_s.last() {
-                    if v <= previous {
-                        return Err(err(
-                            line,
-                            s.name(),
-                            Problem::TimeNotIncreasing { previous, value: v },
-                        ));
-                    }
+                if let Some(problem) = log.t_s.last().and_then(|p| time_problem(*p, v)) {
+                    return Err(err(line, s.name(), problem));
                 }
             }
             log.column_mut(s).push(v);
@@ -675,6 +697,18 @@ fn metadata_fits(k: &str, v: &str) -> bool {
         && !k.contains([':', '\n', '\r'])
         && k.trim() == k
         && !v.contains(['\n', '\r'])
+}
+
+/// What is wrong with a row at `value` [s] after one at `previous` [s]: time going back or
+/// standing, or a step shorter than any sampler makes.
+pub fn time_problem(previous: f64, value: f64) -> Option<Problem> {
+    if value <= previous {
+        Some(Problem::TimeNotIncreasing { previous, value })
+    } else if value - previous < MIN_SAMPLE_INTERVAL_S {
+        Some(Problem::IntervalTooShort { previous, value })
+    } else {
+        None
+    }
 }
 
 /// Whether `v` lies outside the physical range of `signal`'s column.
