@@ -768,3 +768,57 @@ fn metadata_beyond_a_header_is_refused_naming_the_line() {
         &["bulky.csv", "line 18", "bytes of metadata"],
     );
 }
+
+#[test]
+fn a_table_trailer_id_is_read_whole() {
+    use firmware::compensation::record::{Encoder, CRC, RECORD_LEN};
+    use host_sim::compensate::flow::FlowParams;
+    let dir = scratch("trailer-id");
+    let mut record = [0u8; RECORD_LEN];
+    Encoder::write_all(&firmware::compensation::Table::ZERO, &mut record);
+    let trailer = FlowParams {
+        pistons: 9,
+        ratio: 0.0152,
+        phase_rad: 0.0,
+        inertia_kg_m2: 8e-4,
+    }
+    .trailer();
+    // The first parameter's id field (offset 8, four bytes) set to `id`, the CRC renewed.
+    let table = |id: u32| {
+        let mut t = trailer.clone();
+        t[8..12].copy_from_slice(&id.to_le_bytes());
+        let n = t.len();
+        let crc = CRC.checksum(&t[..n - 4]);
+        t[n - 4..].copy_from_slice(&crc.to_le_bytes());
+        let path = dir.join(format!("id{id}.table"));
+        fs::write(&path, [&record[..], &t].concat()).unwrap();
+        path
+    };
+    let out = dir.join("run.csv");
+    let sim = |t: &Path| {
+        vec![
+            "simulate".to_string(),
+            "--scenario".into(),
+            "pressure-hold".into(),
+            "--duration".into(),
+            "0.1".into(),
+            "--out".into(),
+            s(&out).into(),
+            "--compensation".into(),
+            s(t).into(),
+        ]
+    };
+    // 320 = 0x140 and 9999 = 0x270F end in the bytes of ids 64 and 15.
+    for id in [320u32, 9999, 0x0100_0040] {
+        let args = sim(&table(id));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let err = refused(&args, &[&format!("unknown parameter id {id}")]);
+        assert!(!err.contains("id 64") && !err.contains("id 15"), "{err}");
+    }
+    assert!(!out.exists());
+    // The id as written (64) still loads.
+    let args = sim(&table(64));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = eha(&args);
+    assert_eq!(status(&o), 0, "{}", stderr(&o));
+}
