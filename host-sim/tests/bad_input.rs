@@ -822,3 +822,71 @@ fn a_table_trailer_id_is_read_whole() {
     let o = eha(&args);
     assert_eq!(status(&o), 0, "{}", stderr(&o));
 }
+
+#[test]
+fn messages_give_the_true_reason() {
+    let dir = scratch("reasons");
+    let out = dir.join("x.csv");
+    // A cogging order is a count: a fraction, a negative, a huge number and 0 are said to
+    // be no count of cycles, not "no finite number".
+    for v in ["0.5", "-3", "1e30", "0"] {
+        let effects = format!("cogging_torque:order={v}");
+        let err = refused(
+            &[
+                "simulate",
+                "--scenario",
+                "pressure-hold",
+                "--out",
+                s(&out),
+                "--effects",
+                &effects,
+            ],
+            &["order", "whole number from 1 to 10000"],
+        );
+        assert!(!err.contains("finite"), "{err}");
+    }
+    // Left out, the order is the rig's LCM(9 slots, 8 poles) = 72, and the log says 72.
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "0.1",
+        "--out",
+        s(&out),
+        "--effects",
+        "cogging_torque",
+    ]);
+    assert_eq!(status(&o), 0, "{}", stderr(&o));
+    let text = fs::read_to_string(&out).unwrap();
+    let effects = text.lines().find(|l| l.starts_with("# effects:")).unwrap();
+    assert!(effects.contains("order=72"), "{effects}");
+    fs::remove_file(&out).unwrap();
+    // Telemetry codes beyond the firmware's are said to be codes, not "no number".
+    let line = |i: usize, mode: &str, fault: &str| {
+        format!(
+            "EHA1 t_s={} p_ref_pa=5000000 p_pa=5000000 speed_rad_s=6 iq_a=0.5 id_a=0 theta_m_rad=1 speed_ref_rad_s=6 iq_ref_a=0.5 ud_v=0 uq_v=1 udc_v=280 mode={mode} fault={fault} status=0\n",
+            i as f64 * 1e-3
+        )
+    };
+    let text: String = (0..150)
+        .map(|i| match i {
+            3 => line(i, "999", "0"),
+            4 => line(i, "3", "-1"),
+            _ => line(i, "3", "0"),
+        })
+        .collect();
+    let telemetry = dir.join("codes.log");
+    fs::write(&telemetry, text).unwrap();
+    let err = refused(
+        &["ingest", s(&telemetry), "--out", s(&out)],
+        &[
+            "codes.log:4",
+            "not a mode code",
+            "codes.log:5",
+            "not a fault code",
+        ],
+    );
+    assert!(!err.contains("is not a number"), "{err}");
+    assert!(!out.exists());
+}

@@ -94,7 +94,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             ("source".to_string(), "simulation".to_string()),
             ("rig".into(), rig_name(rig).into()),
             ("scenario".into(), scenario.into()),
-            ("effects".into(), effects_text(&effects)),
+            ("effects".into(), effects_text(rig, &effects)),
             ("absorber".into(), absorber.into()),
         ]
     };

@@ -14,7 +14,7 @@ use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
 use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::{by_name, PROCEDURES, SCENARIOS};
-use plant_model::effects::EFFECT_NAMES;
+use plant_model::effects::{EffectError, EFFECT_NAMES};
 use plant_model::{Effect, Rig};
 use serde_json::json;
 use std::fmt::Write as _;
@@ -109,16 +109,32 @@ pub fn parse_effect_list(list: &str) -> Result<EffectList, String> {
     }
     specs
         .iter()
-        .map(|spec| {
-            Effect::parse(spec).map_err(|e| {
-                format!(
-                    "effect `{spec}`: {e} (effects: {})",
-                    EFFECT_NAMES.join(", ")
-                )
-            })
-        })
+        .map(|spec| Effect::parse(spec).map_err(|e| effect_error(spec, e)))
         .collect::<Result<Vec<_>, _>>()
         .map(EffectList)
+}
+
+/// The message for a refused effect `spec`: what is wrong, and for a name or parameter
+/// not in the catalogue, the ones that are.
+fn effect_error(spec: &str, e: EffectError) -> String {
+    let known = match e {
+        EffectError::UnknownEffect => format!(" (effects: {})", EFFECT_NAMES.join(", ")),
+        EffectError::UnknownParameter => {
+            let name = spec.split_once(':').map_or(spec, |(n, _)| n).trim();
+            let params: Vec<&str> = Effect::default_for(name)
+                .map(|d| {
+                    d.parameters()
+                        .into_iter()
+                        .flatten()
+                        .map(|(k, _)| k)
+                        .collect()
+                })
+                .unwrap_or_default();
+            format!(" (its parameters: {})", params.join(", "))
+        }
+        _ => String::new(),
+    };
+    format!("effect `{spec}`: {e}{known}")
 }
 
 pub(crate) fn rig_name(rig: &Rig) -> &'static str {
@@ -129,12 +145,15 @@ pub(crate) fn rig_name(rig: &Rig) -> &'static str {
     }
 }
 
-pub(crate) fn effects_text(effects: &[Effect]) -> String {
+/// `effects` as the log's metadata records them: each as it acts on `rig` (every default
+/// stated, [`Effect::resolved`]), `name:param=value,…` joined by `;`.
+pub(crate) fn effects_text(rig: &Rig, effects: &[Effect]) -> String {
     if effects.is_empty() {
         return "none".into();
     }
     effects
         .iter()
+        .map(|e| e.resolved(rig))
         .map(|e| {
             let params: Vec<String> = e
                 .parameters()
@@ -253,10 +272,11 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         .map(|e| e.0.clone())
         .unwrap_or_default();
     // The plant is the controller's rig unless the bench's actuator is given apart.
-    let plant = match &args.plant_rig {
-        Some(path) => plant_rig(&rig_file::load(path)?, &effects)?,
-        None => plant_rig(&controller, &effects)?,
+    let base = match &args.plant_rig {
+        Some(path) => rig_file::load(path)?,
+        None => controller.clone(),
     };
+    let plant = plant_rig(&base, &effects)?;
     let compensation = match &args.compensation {
         Some(path) => Some(crate::compensate::read_table(path, &controller)?),
         None => None,
@@ -269,7 +289,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         ("source".into(), "simulation".into()),
         ("rig".into(), rig_name(rig).into()),
         ("scenario".into(), scenario.name.into()),
-        ("effects".into(), effects_text(&effects)),
+        ("effects".into(), effects_text(&base, &effects)),
         (
             "precharge_pa".into(),
             format!("{}", controller.absorber.precharge_pa),

@@ -138,7 +138,7 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
             let meta = vec![
                 ("source".to_string(), "simulation".to_string()),
                 ("scenario".into(), "pressure-hold".into()),
-                ("effects".into(), effects_text(&effects)),
+                ("effects".into(), effects_text(rig, &effects)),
                 (
                     "precharge_pa".into(),
                     p0.map(|p| format!("{p}"))
