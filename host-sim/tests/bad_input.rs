@@ -890,3 +890,36 @@ fn messages_give_the_true_reason() {
     assert!(!err.contains("is not a number"), "{err}");
     assert!(!out.exists());
 }
+
+#[test]
+fn tune_proposes_no_gains_from_a_step_the_loop_did_not_follow() {
+    let dir = scratch("tune-unfollowed");
+    let log = dir.join("step.csv");
+    let o = eha(&["simulate", "--scenario", "pressure-step", "--out", s(&log)]);
+    assert_eq!(status(&o), 0, "{}", stderr(&o));
+    // The setpoint steps 3 → 5 MPa; the pressure stays where it was (a loop left open).
+    let flat = edited(&log, "flat.csv", "p_pa", |_, _| "3000000".into());
+    let (json, can) = (dir.join("t.json"), dir.join("t.log"));
+    let o = eha(&[
+        "tune",
+        s(&flat),
+        "--loop",
+        "pressure",
+        "--json",
+        s(&json),
+        "--can-log",
+        s(&can),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(status(&o), 2, "{err}");
+    assert!(
+        err.contains("does not follow") && err.contains("p_pa"),
+        "{err}"
+    );
+    assert!(err.contains("0 % of the way"), "{err}");
+    assert!(
+        String::from_utf8_lossy(&o.stdout).trim().is_empty(),
+        "no CAN lines"
+    );
+    assert!(!json.exists() && !can.exists());
+}
