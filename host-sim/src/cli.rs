@@ -73,13 +73,21 @@ pub fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
-            // Usage errors go to stderr with status 2; --help and --version to stdout, 0.
+            // Usage errors go to stderr with status 2; --help and --version to stdout, 0,
+            // unless standard output cannot take them (a closed pipe is no error).
             let code = ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
             if e.use_stderr() {
                 let text = crate::values::shorten_long_words(&e.render().to_string());
                 let _ = write!(io::stderr(), "{text}");
-            } else {
-                let _ = e.print();
+            } else if let Err(why) = e.print().and_then(|()| io::stdout().flush()) {
+                if why.kind() != io::ErrorKind::BrokenPipe {
+                    let _ = writeln!(
+                        io::stderr(),
+                        "eha: error: cannot write standard output: {}",
+                        paths::describe(&why)
+                    );
+                    return ExitCode::FAILURE;
+                }
             }
             return code;
         }

@@ -923,3 +923,24 @@ fn tune_proposes_no_gains_from_a_step_the_loop_did_not_follow() {
     );
     assert!(!json.exists() && !can.exists());
 }
+
+#[test]
+fn help_on_a_full_standard_output_is_an_error() {
+    for args in [&["--help"][..], &["--version"], &["rig"]] {
+        let full = fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_eha"))
+            .args(args)
+            .stdout(full)
+            .output()
+            .unwrap();
+        assert_eq!(status(&o), 1, "{args:?}");
+        assert!(
+            stderr(&o).to_lowercase().contains("no space left"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+    }
+}
