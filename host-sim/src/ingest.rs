@@ -18,7 +18,7 @@ use crate::bench_log::limits::{
 };
 use crate::bench_log::{self, time_problem, BenchLog, Problem, Signal, MIN_ROWS};
 use crate::output::paths::Declared;
-use crate::output::CliError;
+use crate::output::{CliError, Outputs};
 use clap::Args;
 use firmware::telemetry::{parse_line, ParseError, TelemetryFrame, COLUMNS};
 use std::fmt;
@@ -417,7 +417,9 @@ pub fn run_ingest(args: &IngestArgs) -> Result<(), CliError> {
         ("skipped_lines".into(), ingested.skipped.to_string()),
         ("faulted_frames".into(), ingested.faulted_frames.to_string()),
     ];
-    bench_log::write(&args.out, &ingested.log)?;
+    let mut out = Outputs::new();
+    bench_log::stage(&mut out, "--out", &args.out, &ingested.log)?;
+    out.commit()?;
     eprintln!(
         "ingest: {} telemetry lines of {lines} written to {} ({} other lines skipped, 0 \
          malformed{})",

@@ -26,7 +26,7 @@ pub mod step;
 
 use crate::bench_log::BenchLog;
 use crate::output::paths::Declared;
-use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::output::{is_stdout, CliError, Outputs};
 use crate::values::{non_negative_f64, positive_f64, show};
 use can::Setting;
 use clap::{Args, ValueEnum};
@@ -549,14 +549,15 @@ pub fn run_tune(rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
     let t = t?;
     let frames = can::parameter_commands(&t.settings).map_err(CliError::Failed)?;
     let commands = crate::can_commands::cansend_lines(&frames);
+    let mut out = Outputs::new();
     if let Some(path) = &args.can_log {
-        crate::can_commands::write_candump_log(path, &frames)?;
+        crate::can_commands::stage_candump_log(&mut out, path, &frames)?;
     }
     if let Some(path) = &args.json {
-        write_json(path, &t.to_json(&commands))?;
-        if is_stdout(path) {
-            return Ok(());
-        }
+        out.json("--json", path, &t.to_json(&commands))?;
     }
-    print_stdout(&t.to_text(&commands))
+    if !args.json.as_deref().is_some_and(is_stdout) {
+        out.print(&t.to_text(&commands));
+    }
+    out.commit()
 }

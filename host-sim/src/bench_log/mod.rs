@@ -16,9 +16,9 @@
 //! outside its column's physical range ([`limits::physical_range`]), or two rows closer in
 //! time than any sampler logs ([`limits::MIN_SAMPLE_INTERVAL_S`]) is refused the same way.
 //!
-//! The writer checks the same rules first (so every file it writes reads back), writes the
-//! values in shortest round-trip notation and replaces the target atomically
-//! ([`crate::output::atomic`]): a failed write leaves no partial file.
+//! The writer checks the same rules first (so every file it writes reads back) and writes
+//! the values in shortest round-trip notation, as an output of the command's transaction
+//! ([`crate::output::Outputs`]): a failed write leaves no partial file.
 
 pub mod limits;
 pub mod replayable;
@@ -728,16 +728,44 @@ fn beyond(signal: Signal, value: f64) -> Problem {
     }
 }
 
-/// Writes `log` to `path` atomically, after [`BenchLog::check`]: metadata lines, the header
-/// of the columns present, one row per sample in shortest round-trip notation.
+/// Writes `log` to `path` as a command's one output ([`crate::output::Outputs`]), after
+/// [`BenchLog::check`]: metadata lines, the header of the columns present, one row per
+/// sample in shortest round-trip notation.
 pub fn write(path: &Path, log: &BenchLog) -> Result<(), BenchLogError> {
+    let mut out = crate::output::Outputs::new();
+    stage(&mut out, "", path, log)
+        .and_then(|()| out.commit())
+        .map_err(|e| match e {
+            crate::output::CliError::BenchLog(e) => e,
+            crate::output::CliError::Write { file, source } => {
+                BenchLogError::Write { file, source }
+            }
+            e => BenchLogError::Write {
+                file: path.to_path_buf(),
+                source: io::Error::other(e.to_string()),
+            },
+        })
+}
+
+/// Stages `log` (checked first) as the output file `path` given by `flag`.
+pub fn stage(
+    out: &mut crate::output::Outputs,
+    flag: &str,
+    path: &Path,
+    log: &BenchLog,
+) -> Result<(), crate::output::CliError> {
     log.check(path)?;
-    crate::output::atomic::write_with(path, |w| write_to(w, log)).map_err(|source| {
-        BenchLogError::Write {
-            file: path.to_path_buf(),
-            source,
-        }
-    })
+    out.file_with(flag, path, |w| write_to(w, log))
+}
+
+/// Writes `log` (checked first) as the file `name` of a staged output folder.
+pub fn write_into(
+    d: &crate::output::StagedFolder,
+    name: &str,
+    log: &BenchLog,
+) -> Result<(), crate::output::CliError> {
+    log.check(&d.shown(name))?;
+    d.file_with(name, |w| write_to(w, log))
 }
 
 /// `log` as the bytes [`write`] puts in a file, after the same checks.

@@ -30,7 +30,7 @@ pub mod table;
 
 use crate::bench_log::{self, BenchLog};
 use crate::output::paths::Declared;
-use crate::output::{print_stdout, write_json, CliError};
+use crate::output::{CliError, Outputs};
 use clap::{Args, ValueEnum};
 use firmware::can_protocol::{Frame, NodeId};
 use firmware::compensation::record::{self, RECORD_LEN};
@@ -359,16 +359,12 @@ fn learn_and_predict(
     learned
 }
 
-/// Writes the table file (`bytes`) to `path` atomically.
-fn write_table_file(path: &std::path::Path, bytes: &[u8]) -> Result<(), CliError> {
-    crate::output::atomic::write(path, bytes).map_err(|source| CliError::Write {
-        file: path.to_path_buf(),
-        source,
-    })
-}
-
-/// Writes `frames` to `path` as a `candump -l` log.
-fn write_can_log(path: &std::path::Path, frames: &[Frame]) -> Result<(), CliError> {
+/// Stages `frames` as the `candump -l` log `--can-log path`.
+fn stage_can_log(
+    out: &mut Outputs,
+    path: &std::path::Path,
+    frames: &[Frame],
+) -> Result<(), CliError> {
     let commands: Vec<crate::can_commands::CanCommand> = frames
         .iter()
         .map(|f| crate::can_commands::CanCommand {
@@ -376,18 +372,19 @@ fn write_can_log(path: &std::path::Path, frames: &[Frame]) -> Result<(), CliErro
             what: "compensation table".into(),
         })
         .collect();
-    crate::can_commands::write_candump_log(path, &commands)
+    crate::can_commands::stage_candump_log(out, path, &commands)
 }
 
-/// `eha compensate`: checks the arguments and logs, learns the feed-forward, writes the
-/// table, prints the summary and the CAN frames, then writes the CAN log and the JSON if
-/// asked for.
+/// `eha compensate`: checks the arguments and logs, learns the feed-forward, then writes
+/// the table, the CAN log and the JSON if asked for, together, and prints the summary and
+/// the CAN frames.
 pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> {
     check_exclude(&args.exclude)?;
     let logs = read_logs(rig, args)?;
     let outcome = learn_and_predict(rig, &logs, args)?;
     let bytes = outcome.ff.file_bytes();
-    write_table_file(&args.out, &bytes)?;
+    let mut out = Outputs::new();
+    out.file("--out", &args.out, &bytes)?;
     let node = NodeId::new(crate::tune::can::NODE)
         .map_err(|e| CliError::Failed(format!("CAN node: {e:?}")))?;
     let frames = can::frames(&outcome.ff, node);
@@ -397,18 +394,19 @@ pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> 
         node,
         frames: &frames,
     };
-    print_stdout(&summary::text(
+    // Standard output: the summary, then the JSON when it goes there too (`--json -`).
+    out.print(&summary::text(
         args,
         logs.len(),
         &outcome,
         &in_table,
         &written,
-    ))?;
+    ));
     if let Some(path) = &args.can_log {
-        write_can_log(path, &frames)?;
+        stage_can_log(&mut out, path, &frames)?;
     }
     if let Some(path) = &args.json {
-        write_json(path, &summary::json(args, &outcome, &in_table))?;
+        out.json("--json", path, &summary::json(args, &outcome, &in_table))?;
     }
-    Ok(())
+    out.commit()
 }

@@ -6,9 +6,9 @@ pub mod demo;
 pub mod holding;
 
 use crate::bench_log::limits::MAX_ROWS;
-use crate::bench_log::{self, BenchLog, MIN_ROWS};
+use crate::bench_log::{self, MIN_ROWS};
 use crate::output::paths::Declared;
-use crate::output::{print_stdout, write_json, CliError};
+use crate::output::{CliError, Outputs};
 use crate::rig_file;
 use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
 use crate::values::{positive_f64, show};
@@ -18,7 +18,7 @@ use plant_model::effects::{EffectError, EFFECT_NAMES};
 use plant_model::{Effect, Rig};
 use serde_json::json;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Log rate of the simulated bench logs. [Hz]
 pub const LOG_RATE_HZ: f64 = 2000.0;
@@ -220,11 +220,6 @@ fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<
     Ok(())
 }
 
-pub(crate) fn write_log(path: &Path, log: &BenchLog) -> Result<(), CliError> {
-    bench_log::write(path, log)?;
-    Ok(())
-}
-
 /// `eha simulate`.
 pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     if args.list {
@@ -236,7 +231,9 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
                 sc.name, sc.duration_s, sc.description
             );
         }
-        return print_stdout(&s);
+        let mut out = Outputs::new();
+        out.print(&s);
+        return out.commit();
     }
     let name = args.scenario.as_deref().unwrap_or_default();
     let scenario = by_name(name).ok_or_else(|| {
@@ -331,16 +328,11 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     )
     .map_err(CliError::Failed)
     .and_then(converged)?;
-    write_log(out, &r.log)?;
-    eprintln!(
-        "{}: {} rows over {duration} s written to {} ({:.0}× real time)",
-        scenario.name,
-        r.log.len(),
-        out.display(),
-        r.real_time_factor
-    );
+    let mut outputs = Outputs::new();
+    bench_log::stage(&mut outputs, "--out", out, &r.log)?;
     if let Some(json_path) = &args.json {
-        write_json(
+        outputs.json(
+            "--json",
             json_path,
             &json!({
                 "scenario": scenario.name,
@@ -351,6 +343,14 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             }),
         )?;
     }
+    outputs.commit()?;
+    eprintln!(
+        "{}: {} rows over {duration} s written to {} ({:.0}× real time)",
+        scenario.name,
+        r.log.len(),
+        out.display(),
+        r.real_time_factor
+    );
     Ok(())
 }
 

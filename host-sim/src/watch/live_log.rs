@@ -1,14 +1,15 @@
 //! The bench log `eha watch --out` writes as the frames arrive (`contracts/bench-log.md`,
 //! the same columns and number text as `eha ingest`): rows go to a hidden file beside the
 //! log as they come, and [`LiveLog::finish`] puts the metadata (counts known only at the
-//! end) and the header before them in the log itself, atomically. Until then the log's
-//! path holds what it held before (or nothing); a session stopped by Ctrl-C or a stream
-//! that ends is finished the same way, so every frame taken is in the log.
+//! end) and the header before them in the log itself, as the command's one output
+//! ([`Outputs`]). Until then the log's path holds what it held before (or nothing); a
+//! session stopped by Ctrl-C or a stream that ends is finished the same way, so every
+//! frame taken is in the log.
 
 use crate::bench_log::limits::MAX_ROWS;
 use crate::bench_log::{format_value, MIN_ROWS};
 use crate::ingest::frame_values;
-use crate::output::interrupt;
+use crate::output::{interrupt, CliError, Outputs};
 use firmware::telemetry::{TelemetryFrame, COLUMNS};
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -149,7 +150,8 @@ impl LiveLog {
             });
         }
         let rows_path = self.rows_path.clone();
-        crate::output::atomic::write_with(&self.path, |w| {
+        let mut out = Outputs::new();
+        out.file_with("--out", &self.path, |w| {
             for (k, v) in metadata {
                 writeln!(w, "# {k}: {v}")?;
             }
@@ -157,7 +159,11 @@ impl LiveLog {
             io::copy(&mut File::open(&rows_path)?, w)?;
             Ok(())
         })
-        .map_err(|source| self.failed(source))?;
+        .and_then(|()| out.commit())
+        .map_err(|e| match e {
+            CliError::Write { source, .. } => self.failed(source),
+            e => self.failed(io::Error::other(e.to_string())),
+        })?;
         Ok(self.count)
     }
 }
