@@ -697,13 +697,19 @@ fn hold_rows(meta: &str, rows: usize, t: impl Fn(usize) -> f64) -> String {
 #[test]
 fn a_time_axis_no_sampler_makes_is_refused_naming_the_row() {
     let dir = scratch("time-axis");
-    // Steps of one float ulp at 1 s (2.2e-16 s): increasing, but no sampler's.
-    let ulps = dir.join("ulps.csv");
-    fs::write(&ulps, hold_rows("", 150, |i| 1.0 + i as f64 * 2.3e-16)).unwrap();
+    // A simulated hold whose time steps by one float ulp at 1 s (2.2e-16 s): increasing,
+    // but no sampler's.
+    let hold = hold_log_of(&dir, "hold.csv", "0.5");
+    let ulps = edited(&hold, "ulps.csv", "t_s", |i, _| {
+        format!("{:?}", 1.0 + i as f64 * 2.3e-16)
+    });
     let json = dir.join("d.json");
+    // The second data row, after the metadata and the header.
+    let text = fs::read_to_string(&ulps).unwrap();
+    let line = text.lines().take_while(|l| l.starts_with('#')).count() + 3;
     let err = refused(
         &["diagnose", s(&ulps), "--json", s(&json)],
-        &["ulps.csv", "line 3", "t_s", "1e-6 s apart"],
+        &["ulps.csv", &format!("line {line},"), "t_s", "1e-6 s apart"],
     );
     assert!(err.contains("2.220e-16 s"), "the step said: {err}");
     assert!(!json.exists());
@@ -900,8 +906,10 @@ fn tune_proposes_no_gains_from_a_step_the_loop_did_not_follow() {
     let log = dir.join("step.csv");
     let o = eha(&["simulate", "--scenario", "pressure-step", "--out", s(&log)]);
     assert_eq!(status(&o), 0, "{}", stderr(&o));
-    // The setpoint steps 3 → 5 MPa; the pressure stays where it was (a loop left open).
-    let flat = edited(&log, "flat.csv", "p_pa", |_, _| "3000000".into());
+    // The setpoint steps 3 → 5 MPa at 0.5 s; the pressure reads on as it did before the
+    // step (its first 0.45 s again and again: a loop left open, a sensor on another port).
+    let before: Vec<f64> = host_sim::bench_log::read(&log).unwrap().p_pa[..900].to_vec();
+    let flat = edited(&log, "flat.csv", "p_pa", |k, _| before[k % 900].to_string());
     let (json, can) = (dir.join("t.json"), dir.join("t.log"));
     let o = eha(&[
         "tune",
