@@ -14,7 +14,7 @@
 //! diagnose` and `eha tune`; re-capturing (or cutting the log at the reset) is the fix.
 
 use crate::bench_log::limits::{
-    line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS, MIN_SAMPLE_INTERVAL_S,
+    line_too_long, max_rows, physical_range, LineLimited, MAX_LINE_BYTES, MIN_SAMPLE_INTERVAL_S,
 };
 use crate::bench_log::{self, time_problem, BenchLog, Problem, Signal, MIN_ROWS};
 use crate::output::paths::Declared;
@@ -182,9 +182,10 @@ pub enum IngestError {
     },
     /// More telemetry frames than a bench log may hold.
     #[error(
-        "defmt log `{}`: more than {MAX_ROWS} telemetry lines; a bench log holds at most that \
-         many rows (split the capture)",
-        file.display()
+        "defmt log `{}`: more than {} telemetry lines; a bench log of the telemetry's \
+         columns holds at most that many rows (split the capture)",
+        file.display(),
+        max_rows(COLUMNS.len())
     )]
     TooManyFrames {
         /// The file.
@@ -352,7 +353,7 @@ pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), 
                 continue;
             }
         };
-        if out.frames() == MAX_ROWS {
+        if out.frames() == max_rows(COLUMNS.len()) {
             return Err(IngestError::TooManyFrames {
                 file: file.to_path_buf(),
             });

@@ -11,7 +11,8 @@
 //! unread (a rig's logger may add a text column); unknown metadata keys are kept.
 //!
 //! Beyond the contract, for bounded memory and arithmetic: a line longer than
-//! [`limits::MAX_LINE_BYTES`], more than [`limits::MAX_ROWS`] rows, more metadata than
+//! [`limits::MAX_LINE_BYTES`], more rows than [`limits::max_rows`] allows (at most
+//! [`limits::MAX_ROWS`], and [`limits::MAX_VALUES`] values), more metadata than
 //! [`limits::MAX_METADATA_LINES`] lines or [`limits::MAX_METADATA_BYTES`] bytes, a value
 //! outside its column's physical range ([`limits::physical_range`]), or two rows closer in
 //! time than any sampler logs ([`limits::MIN_SAMPLE_INTERVAL_S`]) is refused the same way.
@@ -25,7 +26,7 @@ pub mod replayable;
 
 use limits::{
     excerpt, line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_METADATA_BYTES,
-    MAX_METADATA_LINES, MAX_ROWS, MIN_SAMPLE_INTERVAL_S,
+    MAX_METADATA_LINES, MAX_ROWS, MAX_VALUES, MIN_SAMPLE_INTERVAL_S,
 };
 use std::fmt::Write as _;
 use std::fs::File;
@@ -307,11 +308,12 @@ impl BenchLog {
                 return Err(content(header_line + 1 + i, s.name(), beyond(s, c[i])));
             }
         }
-        if rows > MAX_ROWS {
+        let most = limits::max_rows(self.columns().count());
+        if rows > most {
             return Err(content(
-                header_line + 1 + MAX_ROWS,
+                header_line + 1 + most,
                 Signal::Time.name(),
-                Problem::TooManyRows,
+                Problem::TooManyRows { most },
             ));
         }
         let mut steps = self.t_s.windows(2).enumerate();
@@ -368,8 +370,14 @@ pub enum Problem {
         unit: &'static str,
     },
     /// More rows than a bench log may have.
-    #[error("more than {MAX_ROWS} data rows; split the log")]
-    TooManyRows,
+    #[error(
+        "more than {most} data rows; a bench log holds at most {MAX_ROWS} rows and \
+         {MAX_VALUES} values of the contract's columns: split the log"
+    )]
+    TooManyRows {
+        /// The most rows a log of these columns may have.
+        most: usize,
+    },
     /// A line longer than a bench log's longest.
     #[error("line longer than {MAX_LINE_BYTES} bytes (not a bench log, or a binary file?)")]
     LineTooLong,
@@ -628,6 +636,7 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     for &(_, s) in &known {
         log.column_mut(s);
     }
+    let most_rows = limits::max_rows(known.len());
 
     let mut last_line = header_line;
     while reader
@@ -636,8 +645,9 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     {
         let line = line_of(&record, last_line + 1);
         last_line = line;
-        if log.len() == MAX_ROWS {
-            return Err(err(line, Signal::Time.name(), Problem::TooManyRows));
+        if log.len() == most_rows {
+            let problem = Problem::TooManyRows { most: most_rows };
+            return Err(err(line, Signal::Time.name(), problem));
         }
         if record.len() != names.len() {
             let column = names

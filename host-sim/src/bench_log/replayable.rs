@@ -5,6 +5,7 @@
 //! periodic effects (tens of cycles per revolution) only from densely sampled data.
 //!
 //! - the span is at most [`MAX_SPAN_S`], the contract's longest typical log;
+//! - the rows are at most [`MAX_REPLAYED_ROWS`], for bounded memory;
 //! - the median sampling interval is at most [`MAX_MEDIAN_INTERVAL_S`];
 //! - no interval exceeds [`GAP_FACTOR`] medians and [`MIN_GAP_S`] (a gap in the record:
 //!   the replay would run blind through it and meet the log again somewhere else);
@@ -19,6 +20,12 @@ use std::path::Path;
 
 /// Longest time span replayed: the contract's largest typical bench log. [s]
 pub const MAX_SPAN_S: f64 = 600.0;
+
+/// Most rows replayed: the diagnosis keeps every row's measured, simulated and residual
+/// traces (some hundreds of bytes a row; `docs/memory.md` has the measured figures), so
+/// that it stays under 1 GiB of memory; the whole [`MAX_SPAN_S`] at 3.3 kHz, or 200 s at
+/// 10 kHz.
+pub const MAX_REPLAYED_ROWS: usize = 2_000_000;
 
 /// Longest median sampling interval (100 Hz): below it the pulsation orders of a pump
 /// turning a few revolutions per second alias. [s]
@@ -56,6 +63,18 @@ pub fn check(log: &BenchLog, rig: &Rig, file: &Path) -> Result<(), BenchLogError
             format!(
                 "the log spans {span:.1} s; the diagnosis replays at most {MAX_SPAN_S} s (its \
                  time grows with the span): cut the log to the part to explain"
+            ),
+        ));
+    }
+    if n > MAX_REPLAYED_ROWS {
+        return Err(at(
+            MAX_REPLAYED_ROWS,
+            "t_s",
+            format!(
+                "the log has {n} rows; the diagnosis replays at most {MAX_REPLAYED_ROWS} (it \
+                 keeps every row's traces, within 1 GiB of memory): cut the log to the part \
+                 to explain, or log at a lower rate ({:.0} Hz holds the {MAX_SPAN_S} s)",
+                MAX_REPLAYED_ROWS as f64 / MAX_SPAN_S
             ),
         ));
     }

@@ -122,13 +122,28 @@ pub fn find(logs: &[BenchLog], rig: &Rig) -> Result<Found, CliError> {
     })
 }
 
+/// Most rows learned from, over all the logs: the learning diagnoses each log and keeps
+/// every row's traces of all of them at once (more bytes a row than one diagnosis;
+/// `docs/memory.md`), so that it stays under 1 GiB of memory.
+pub const MAX_LEARNED_ROWS: usize = 1_500_000;
+
 /// Reads and checks the logs (bad input before any work).
 fn read_logs(rig: &Rig, args: &CompensateArgs) -> Result<Vec<BenchLog>, CliError> {
+    let mut rows = 0;
     args.logs
         .iter()
         .map(|path| {
             let log = bench_log::read(path)?;
             bench_log::replayable::check(&log, rig, path)?;
+            rows += log.len();
+            if rows > MAX_LEARNED_ROWS {
+                return Err(CliError::BadInput(format!(
+                    "bench log `{}` brings the logs to {rows} rows; eha compensate learns from \
+                     at most {MAX_LEARNED_ROWS} in all (it keeps every row's traces, within \
+                     1 GiB of memory): give fewer or shorter logs, or log at a lower rate",
+                    path.display()
+                )));
+            }
             if log.theta_m_rad.is_none() {
                 return Err(CliError::BadInput(format!(
                     "bench log `{}` has no theta_m_rad column: an angle-indexed table needs \

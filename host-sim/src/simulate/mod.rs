@@ -5,12 +5,11 @@
 pub mod demo;
 pub mod holding;
 
-use crate::bench_log::limits::MAX_ROWS;
 use crate::bench_log::{self, MIN_ROWS};
 use crate::output::paths::Declared;
 use crate::output::{CliError, Outputs};
 use crate::rig_file;
-use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
+use crate::run::{first_unphysical, log_plan, most_rows, run, Run, RunOptions, LOGGED_COLUMNS};
 use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::{by_name, PROCEDURES, SCENARIOS};
@@ -195,7 +194,7 @@ pub(crate) fn converged(run: Run) -> Result<Run, CliError> {
 }
 
 /// Checks before a run that `duration_s` [s] at `log_rate_hz` [Hz] gives a bench log of
-/// [`MIN_ROWS`] to [`MAX_ROWS`] rows (`period_s`: the PWM period [s]).
+/// [`MIN_ROWS`] to [`most_rows`] rows (`period_s`: the PWM period [s]).
 fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<(), CliError> {
     let (every, rows) = log_plan(duration_s, log_rate_hz, period_s);
     let rate = 1.0 / (period_s * every as f64);
@@ -204,12 +203,13 @@ fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<
         show(duration_s),
         show(log_rate_hz)
     );
-    if rows > MAX_ROWS as f64 {
+    let most = most_rows();
+    if rows > most as f64 {
         return Err(CliError::BadInput(format!(
-            "{asked} would log {} rows; a bench log holds at most {MAX_ROWS} ({:.0} s at this \
-             rate)",
+            "{asked} would log {} rows; a bench log of its {LOGGED_COLUMNS} columns holds at \
+             most {most} ({:.0} s at this rate)",
             show(rows),
-            MAX_ROWS as f64 / rate
+            most as f64 / rate
         )));
     }
     if rows < MIN_ROWS as f64 {

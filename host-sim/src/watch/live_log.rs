@@ -6,7 +6,7 @@
 //! session stopped by Ctrl-C or a stream that ends is finished the same way, so every
 //! frame taken is in the log.
 
-use crate::bench_log::limits::MAX_ROWS;
+use crate::bench_log::limits::max_rows;
 use crate::bench_log::{format_value, MIN_ROWS};
 use crate::ingest::frame_values;
 use crate::output::{interrupt, CliError, Outputs};
@@ -97,9 +97,10 @@ impl LiveLog {
         &self.path
     }
 
-    /// True once the log holds as many rows as a bench log may ([`MAX_ROWS`]).
+    /// True once the log holds as many rows as a bench log of the telemetry's columns may
+    /// ([`max_rows`]).
     pub fn is_full(&self) -> bool {
-        self.count >= MAX_ROWS
+        self.count >= max_rows(COLUMNS.len())
     }
 
     /// Appends a frame (ignored once the log [`is_full`](Self::is_full)).
