@@ -134,6 +134,8 @@ pub struct HydraulicInputs<'a> {
     pub p_pa: &'a [f64],
     /// Rows a window's start is fitted to ([`START_S`] at the log's sampling).
     pub start_rows: usize,
+    /// The fill level the port's check valve holds it above, as the transducer reads it. [Pa]
+    pub fill_pa: f64,
 }
 
 impl<'a> HydraulicInputs<'a> {
@@ -143,9 +145,17 @@ impl<'a> HydraulicInputs<'a> {
             t_s: &log.t_s,
             theta_rad: &facts.theta_rad,
             p_low_pa: &facts.p_low_pa,
-            x_m: log.x_m.as_deref().filter(|_| facts.piston_moves),
+            x_m: facts.x_smooth_m.as_deref(),
             p_pa: &log.p_pa,
             start_rows: rows_spanning(START_S, facts.period_s, 2),
+            // The check valve opens only where the port is the suction side: a moving
+            // payload's. A blocked cylinder's port stays above the fill, and there the floor
+            // would only bend the windows' start, which is fitted as if linear.
+            fill_pa: if facts.piston_moves {
+                facts.fill_pa
+            } else {
+                f64::NEG_INFINITY
+            },
         }
     }
 }
@@ -277,6 +287,9 @@ impl Hydraulics {
             o[0] = gain * st.s + hp.sensor_offset_pa;
         }
         let per_rad = hp.displacement_m3_per_rev / (2.0 * PI);
+        // The check valve from the fill holds the port at the fill level: the transducer's
+        // reading of it in true pressure.
+        let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
         // The transducer's step factor 1 − e^(−h/τ), recomputed only when h changes.
         let mut lag = (f64::NAN, 1.0);
         for k in rows.start..rows.end - 1 {
@@ -309,7 +322,7 @@ impl Hydraulics {
                 let volume = hp.high_side_volume_m3 + hp.area_m2 * (x0 + f * dx);
                 let c_oil = volume.max(1e-9) / hp.bulk_modulus_pa;
                 for st in st.iter_mut() {
-                    self.substep(st, h, q_in, p_low, c_oil, lag.1);
+                    self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
                 }
             }
             for (o, st) in out.iter_mut().zip(&st) {
@@ -343,7 +356,8 @@ impl Hydraulics {
     /// One backward-Euler substep of length `h` with inflow `q_in`, see the module docs;
     /// `lag` is the transducer's step factor 1 − e^(−h/τ).
     #[inline]
-    fn substep(&self, st: &mut State, h: f64, q_in: f64, p_low: f64, c_oil: f64, lag: f64) {
+    fn substep(&self, st: &mut State, h: f64, flows: [f64; 3], c_oil: f64, lag: f64) {
+        let [q_in, p_low, floor] = flows;
         let hp = &self.params;
         let g = hp.leakage_m3_s_pa;
         let rhs = c_oil * st.p + h * q_in + h * g * p_low;
@@ -376,7 +390,8 @@ impl Hydraulics {
                 st.v = v_new;
             }
         }
-        st.p = p_new;
+        // The check valve from the fill feeds the port below the fill level.
+        st.p = p_new.max(floor);
         st.s += (st.p - st.s) * lag;
     }
 }
@@ -397,6 +412,7 @@ mod tests {
             x_m: None,
             p_pa: &p,
             start_rows: 10,
+            fill_pa: 0.0,
         };
         let mut out = vec![0.0; n];
         Hydraulics::new(hp.clone(), &Rig::nominal()).simulate_window(
