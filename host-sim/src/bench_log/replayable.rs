@@ -139,3 +139,36 @@ pub fn check(log: &BenchLog, rig: &Rig, file: &Path) -> Result<(), BenchLogError
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A log of `n` rows at 10 kHz, every signal varying.
+    fn log_of(n: usize) -> BenchLog {
+        let ramp: Vec<f64> = (0..n).map(|k| (k % 1000) as f64).collect();
+        BenchLog {
+            t_s: (0..n).map(|k| k as f64 * 1e-4).collect(),
+            p_ref_pa: vec![5e6; n],
+            p_pa: ramp.iter().map(|r| 5e6 + r).collect(),
+            speed_rad_s: ramp.iter().map(|r| r * 1e-3).collect(),
+            iq_a: ramp.iter().map(|r| r * 1e-3).collect(),
+            id_a: vec![0.0; n],
+            ..BenchLog::default()
+        }
+    }
+
+    #[test]
+    fn a_log_beyond_the_replayed_rows_is_refused_naming_the_bound() {
+        let rig = Rig::nominal();
+        let file = Path::new("long.csv");
+        // 200 s at 10 kHz is within the span; one row more than the bound is refused.
+        let e = check(&log_of(MAX_REPLAYED_ROWS + 1), &rig, file).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("2000001 rows") && text.contains("at most 2000000"),
+            "{text}"
+        );
+        check(&log_of(MAX_REPLAYED_ROWS), &rig, file).unwrap();
+    }
+}
