@@ -4,12 +4,12 @@
 //! would give (piston position, low-side pressure), and the true port pressure kept aside
 //! for the pulsation study.
 //!
-//! A run is bounded before it starts: it may log at most the bench log's
-//! [`MAX_ROWS`](crate::bench_log::limits::MAX_ROWS) rows ([`log_plan`]); [`first_unphysical`]
+//! A run is bounded before it starts: it may log at most the rows a bench log of its
+//! [`LOGGED_COLUMNS`] may hold ([`most_rows`], [`log_plan`]); [`first_unphysical`]
 //! finds where a run's state left the physical range (a rig the integration cannot follow),
 //! for the commands to report instead of writing it.
 
-use crate::bench_log::limits::{physical_range, MAX_ROWS};
+use crate::bench_log::limits::{max_rows, physical_range};
 use crate::bench_log::BenchLog;
 use crate::compensate::Feedforward;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
@@ -53,6 +53,16 @@ pub struct RunOptions {
     /// controller before the run, and enabled, as the drive loads it from flash (`None`:
     /// uncompensated).
     pub compensation: Option<Feedforward>,
+}
+
+/// The bench-log columns a run logs: the six required, the shaft angle, piston position,
+/// low-side pressure, speed and current references and the three voltages.
+pub const LOGGED_COLUMNS: usize = 14;
+
+/// The most rows a run logs: those of a bench log of [`LOGGED_COLUMNS`] columns (the run
+/// keeps two columns of truth beside them, 16 values a row, under 1 GiB at this bound).
+pub const fn most_rows() -> usize {
+    max_rows(LOGGED_COLUMNS)
 }
 
 /// How a run of `duration_s` [s] is logged at `log_rate_hz` [Hz] with the PWM period
@@ -100,7 +110,7 @@ pub fn load_compensation(cl: &mut ClosedLoop, ff: &Feedforward) -> Result<(), St
 
 /// Runs `scenario` on the plant `plant_rig`, controlled by the configuration of
 /// `controller_rig` (the rig file the engineer believes in). Fails before any work if the
-/// log would exceed [`MAX_ROWS`].
+/// log would exceed [`most_rows`].
 pub fn run(
     plant_rig: &Rig,
     controller_rig: &Rig,
@@ -124,10 +134,12 @@ pub fn run_with_config(
         load_compensation(&mut cl, table)?;
     }
     let (every, rows) = log_plan(opt.duration_s, opt.log_rate_hz, cl.period_s());
-    if rows.is_nan() || rows > MAX_ROWS as f64 {
+    if rows.is_nan() || rows > most_rows() as f64 {
         return Err(format!(
-            "{} s at {} Hz would log {rows:.0} rows; a bench log holds at most {MAX_ROWS}",
-            opt.duration_s, opt.log_rate_hz
+            "{} s at {} Hz would log {rows:.0} rows; a bench log of its columns holds at most {}",
+            opt.duration_s,
+            opt.log_rate_hz,
+            most_rows()
         ));
     }
     let n_rows = rows as usize;
@@ -219,4 +231,30 @@ pub fn run_with_config(
         absorber_zeta: zeta,
         real_time_factor: opt.duration_s / wall.max(1e-9),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_run_logs_the_columns_its_row_bound_counts() {
+        let rig = Rig::nominal();
+        let scenario = closed_loop::by_name("pressure-hold").unwrap();
+        let r = run(
+            &rig,
+            &rig,
+            scenario,
+            &RunOptions {
+                duration_s: 0.01,
+                log_rate_hz: 2000.0,
+                seed: 1,
+                progress: false,
+                metadata: Vec::new(),
+                compensation: None,
+            },
+        )
+        .unwrap();
+        assert_eq!(r.log.columns().count(), LOGGED_COLUMNS);
+    }
 }

@@ -5,20 +5,19 @@
 pub mod demo;
 pub mod holding;
 
-use crate::bench_log::limits::MAX_ROWS;
-use crate::bench_log::{self, BenchLog, MIN_ROWS};
+use crate::bench_log::{self, MIN_ROWS};
 use crate::output::paths::Declared;
-use crate::output::{print_stdout, write_json, CliError};
+use crate::output::{CliError, Outputs};
 use crate::rig_file;
-use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
+use crate::run::{first_unphysical, log_plan, most_rows, run, Run, RunOptions, LOGGED_COLUMNS};
 use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::{by_name, PROCEDURES, SCENARIOS};
-use plant_model::effects::EFFECT_NAMES;
+use plant_model::effects::{EffectError, EFFECT_NAMES};
 use plant_model::{Effect, Rig};
 use serde_json::json;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Log rate of the simulated bench logs. [Hz]
 pub const LOG_RATE_HZ: f64 = 2000.0;
@@ -109,16 +108,32 @@ pub fn parse_effect_list(list: &str) -> Result<EffectList, String> {
     }
     specs
         .iter()
-        .map(|spec| {
-            Effect::parse(spec).map_err(|e| {
-                format!(
-                    "effect `{spec}`: {e} (effects: {})",
-                    EFFECT_NAMES.join(", ")
-                )
-            })
-        })
+        .map(|spec| Effect::parse(spec).map_err(|e| effect_error(spec, e)))
         .collect::<Result<Vec<_>, _>>()
         .map(EffectList)
+}
+
+/// The message for a refused effect `spec`: what is wrong, and for a name or parameter
+/// not in the catalogue, the ones that are.
+fn effect_error(spec: &str, e: EffectError) -> String {
+    let known = match e {
+        EffectError::UnknownEffect => format!(" (effects: {})", EFFECT_NAMES.join(", ")),
+        EffectError::UnknownParameter => {
+            let name = spec.split_once(':').map_or(spec, |(n, _)| n).trim();
+            let params: Vec<&str> = Effect::default_for(name)
+                .map(|d| {
+                    d.parameters()
+                        .into_iter()
+                        .flatten()
+                        .map(|(k, _)| k)
+                        .collect()
+                })
+                .unwrap_or_default();
+            format!(" (its parameters: {})", params.join(", "))
+        }
+        _ => String::new(),
+    };
+    format!("effect `{spec}`: {e}{known}")
 }
 
 pub(crate) fn rig_name(rig: &Rig) -> &'static str {
@@ -129,12 +144,15 @@ pub(crate) fn rig_name(rig: &Rig) -> &'static str {
     }
 }
 
-pub(crate) fn effects_text(effects: &[Effect]) -> String {
+/// `effects` as the log's metadata records them: each as it acts on `rig` (every default
+/// stated, [`Effect::resolved`]), `name:param=value,…` joined by `;`.
+pub(crate) fn effects_text(rig: &Rig, effects: &[Effect]) -> String {
     if effects.is_empty() {
         return "none".into();
     }
     effects
         .iter()
+        .map(|e| e.resolved(rig))
         .map(|e| {
             let params: Vec<String> = e
                 .parameters()
@@ -176,7 +194,7 @@ pub(crate) fn converged(run: Run) -> Result<Run, CliError> {
 }
 
 /// Checks before a run that `duration_s` [s] at `log_rate_hz` [Hz] gives a bench log of
-/// [`MIN_ROWS`] to [`MAX_ROWS`] rows (`period_s`: the PWM period [s]).
+/// [`MIN_ROWS`] to [`most_rows`] rows (`period_s`: the PWM period [s]).
 fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<(), CliError> {
     let (every, rows) = log_plan(duration_s, log_rate_hz, period_s);
     let rate = 1.0 / (period_s * every as f64);
@@ -185,12 +203,13 @@ fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<
         show(duration_s),
         show(log_rate_hz)
     );
-    if rows > MAX_ROWS as f64 {
+    let most = most_rows();
+    if rows > most as f64 {
         return Err(CliError::BadInput(format!(
-            "{asked} would log {} rows; a bench log holds at most {MAX_ROWS} ({:.0} s at this \
-             rate)",
+            "{asked} would log {} rows; a bench log of its {LOGGED_COLUMNS} columns holds at \
+             most {most} ({:.0} s at this rate)",
             show(rows),
-            MAX_ROWS as f64 / rate
+            most as f64 / rate
         )));
     }
     if rows < MIN_ROWS as f64 {
@@ -198,11 +217,6 @@ fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<
             "{asked} would log {rows} rows; a bench log needs at least {MIN_ROWS}"
         )));
     }
-    Ok(())
-}
-
-pub(crate) fn write_log(path: &Path, log: &BenchLog) -> Result<(), CliError> {
-    bench_log::write(path, log)?;
     Ok(())
 }
 
@@ -217,7 +231,9 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
                 sc.name, sc.duration_s, sc.description
             );
         }
-        return print_stdout(&s);
+        let mut out = Outputs::new();
+        out.print(&s);
+        return out.commit();
     }
     let name = args.scenario.as_deref().unwrap_or_default();
     let scenario = by_name(name).ok_or_else(|| {
@@ -253,10 +269,11 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         .map(|e| e.0.clone())
         .unwrap_or_default();
     // The plant is the controller's rig unless the bench's actuator is given apart.
-    let plant = match &args.plant_rig {
-        Some(path) => plant_rig(&rig_file::load(path)?, &effects)?,
-        None => plant_rig(&controller, &effects)?,
+    let base = match &args.plant_rig {
+        Some(path) => rig_file::load(path)?,
+        None => controller.clone(),
     };
+    let plant = plant_rig(&base, &effects)?;
     let compensation = match &args.compensation {
         Some(path) => Some(crate::compensate::read_table(path, &controller)?),
         None => None,
@@ -269,7 +286,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         ("source".into(), "simulation".into()),
         ("rig".into(), rig_name(rig).into()),
         ("scenario".into(), scenario.name.into()),
-        ("effects".into(), effects_text(&effects)),
+        ("effects".into(), effects_text(&base, &effects)),
         (
             "precharge_pa".into(),
             format!("{}", controller.absorber.precharge_pa),
@@ -311,16 +328,11 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     )
     .map_err(CliError::Failed)
     .and_then(converged)?;
-    write_log(out, &r.log)?;
-    eprintln!(
-        "{}: {} rows over {duration} s written to {} ({:.0}× real time)",
-        scenario.name,
-        r.log.len(),
-        out.display(),
-        r.real_time_factor
-    );
+    let mut outputs = Outputs::new();
+    bench_log::stage(&mut outputs, "--out", out, &r.log)?;
     if let Some(json_path) = &args.json {
-        write_json(
+        outputs.json(
+            "--json",
             json_path,
             &json!({
                 "scenario": scenario.name,
@@ -331,6 +343,14 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             }),
         )?;
     }
+    outputs.commit()?;
+    eprintln!(
+        "{}: {} rows over {duration} s written to {} ({:.0}× real time)",
+        scenario.name,
+        r.log.len(),
+        out.display(),
+        r.real_time_factor
+    );
     Ok(())
 }
 
