@@ -23,8 +23,10 @@
 //! signal of each (effect, scenario) pair is where its closed-loop signature stands
 //! furthest above the sensor noise ([`signal_for`]), measured with [`signature`].
 
+pub mod judge;
 mod observability;
 mod structure;
+pub mod table;
 
 pub use observability::{
     angle_locked_fit_bound, line_below_noise, line_fit_bound, ripple_orders, signature, Signature,
