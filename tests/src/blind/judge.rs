@@ -374,7 +374,10 @@ mod tests {
         let pair = [leak.clone(), offset.clone()];
         let std = Standard::Every;
         assert!(failures(&pair, &said(&[offset.clone(), leak.clone()]), std).is_empty());
-        assert_eq!(failures(&pair, &said(std::slice::from_ref(&leak)), std).len(), 1);
+        assert_eq!(
+            failures(&pair, &said(std::slice::from_ref(&leak)), std).len(),
+            1
+        );
         assert_eq!(
             failures(
                 &pair,
