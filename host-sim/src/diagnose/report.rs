@@ -146,6 +146,7 @@ fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliE
     let mut md = String::new();
     summary_section(&mut md, log_path, d);
     ranking_section(&mut md, d);
+    contributions_section(&mut md, a);
     signatures_section(&mut md, a);
     trace_section(dir, &mut md, &mut files, a)?;
     spectrum_section(dir, &mut md, &mut files, a)?;
@@ -218,6 +219,34 @@ fn ranking_section(md: &mut String, d: &Diagnosis) {
             c.evidence
         );
     }
+}
+
+/// Each named effect's fit points gained per signal as it joins the model.
+fn contributions_section(md: &mut String, a: &Analysis) {
+    let Some((_, first)) = a.contributions.first() else {
+        return;
+    };
+    let signals: Vec<&String> = first.keys().collect();
+    let _ = writeln!(
+        md,
+        "## Contributions\n\nFit points on the validation segment each named effect gains \
+         per signal as it joins the model, the strongest first (the last row ends at the \
+         extended model).\n\n| effect | {} |\n|---|{}",
+        signals
+            .iter()
+            .map(|s| format!("`{s}`"))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        "---|".repeat(signals.len())
+    );
+    for (effect, gained) in &a.contributions {
+        let cells: Vec<String> = signals
+            .iter()
+            .map(|s| gained.get(*s).map_or("—".into(), |g| format!("{g:+.1}")))
+            .collect();
+        let _ = writeln!(md, "| `{effect}` | {} |", cells.join(" | "));
+    }
+    md.push('\n');
 }
 
 /// The baseline residuals' time-domain signatures, when there are any.
