@@ -47,6 +47,7 @@ pub const FOREIGN_STYLE: Scenario = Scenario {
         None,
         None,
     ],
+    profile: None,
 };
 
 /// Length of the learning hold at 5 MPa. [s]
