@@ -468,6 +468,7 @@ pub fn simulate(
         progress: false,
         metadata: vec![("source".into(), "blind-suite".into())],
         compensation: None,
+        integrator: Default::default(),
     };
     let config = controller.apply(&controller_config(&Rig::nominal()));
     Ok(run_with_config(plant_rig, &config, scenario, &opt)?.log)
