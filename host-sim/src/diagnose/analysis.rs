@@ -20,7 +20,6 @@ use super::calibration::{
 };
 use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
 use super::cylinder::{self, CylinderRelation};
-use super::decision::{apply_vetoes, decide};
 use super::diagnosis::Diagnosis;
 use super::electrical::ElectricalRelation;
 use super::facts::{rows_spanning, LogFacts};
@@ -29,6 +28,7 @@ use super::lines::window_lines;
 use super::mechanical::ShaftMotion;
 use super::predictions::{predict, Context, ModelValues};
 use super::result::{assemble, extended_values};
+use super::selection::select;
 use super::signatures::ResidualSignature;
 use super::spectrum::OrderSpectrum;
 use super::DiagnoseError;
@@ -179,7 +179,7 @@ impl<'a> Relations<'a> {
     }
 
     /// `relation` fitted with the precision's patience.
-    fn patient<'r, R>(&self, relation: &'r R) -> Patient<'r, R> {
+    pub(super) fn patient<'r, R>(&self, relation: &'r R) -> Patient<'r, R> {
         Patient {
             relation,
             patience: self.patience,
@@ -246,8 +246,11 @@ fn test_relations(
         hyd_releases.push(Release::Precharge);
     }
     // A piston that moves without its position logged: the volume balance lacks its
-    // largest flow, and no hydraulic effect can be told from it.
-    if facts.piston_unseen {
+    // largest flow, and no hydraulic effect can be told from it. With it logged, the
+    // payload's force balance holds the port pressure and the volume balance multiplies the
+    // position transducer's noise by the oil's stiffness: the pressure is not the signal
+    // that reads the hydraulic effects there.
+    if facts.piston_unseen || facts.piston_moves {
         hyd_releases.clear();
     }
     let (h, m) = (&cal.hydraulic, &cal.mechanical);
@@ -346,7 +349,7 @@ pub fn analyse_reporting(
         d_per_rad: mv[mech::DISPLACEMENT] / (2.0 * std::f64::consts::PI),
     };
     let orders = &rel.orders;
-    let lines = window_lines(log, &facts, orders, shaft.kt, shaft.j, shaft.d_per_rad);
+    let lines = window_lines(log, &facts, rig, orders, shaft.kt, shaft.j, shaft.d_per_rad);
     let (line_id, line_val): (Vec<_>, Vec<_>) = lines
         .iter()
         .partition(|w| w.window.rows.start < facts.split);
@@ -374,9 +377,8 @@ pub fn analyse_reporting(
     }
     tested.extend(line_tests);
     progress.step("predictions");
-    // 5. Decision.
-    apply_vetoes(&mut tested);
-    let named = decide(&tested);
+    // 5. Selection: every effect the log convicts.
+    let (named, hydraulic_values) = select(&rel, &mut tested, rig);
     // 6. Predictions and scores.
     let ctx = Context {
         log,
@@ -393,16 +395,21 @@ pub fn analyse_reporting(
         electrical: cal.electrical.as_ref().map(|c| c.fitted.values.clone()),
         cylinder: cal.cylinder.as_ref().map(|c| c.fitted.values.clone()),
         pressure_from_cylinder: named
-            .is_some_and(|i| matches!(tested[i].extension, Extension::Cylinder(_))),
+            .iter()
+            .any(|&i| matches!(tested[i].extension, Extension::Cylinder(_))),
     };
-    let ext_values = match named {
-        Some(i) => extended_values(&base_values, &tested[i].extension, rig, shaft),
-        None => base_values.clone(),
-    };
+    let mut ext_values = base_values.clone();
+    for &i in &named {
+        ext_values = extended_values(&ext_values, &tested[i].extension, rig, shaft);
+    }
+    if let Some(v) = hydraulic_values {
+        ext_values.hydraulic = v;
+    }
     let baseline = predict(&ctx, &base_values);
-    let extended = match named {
-        Some(_) => predict(&ctx, &ext_values),
-        None => baseline.clone(),
+    let extended = if named.is_empty() {
+        baseline.clone()
+    } else {
+        predict(&ctx, &ext_values)
     };
     progress.step("evidence");
     let a = assemble(log, &facts, &rel, &cal, tested, named, baseline, extended);

@@ -170,6 +170,9 @@ impl<R: Relation> Relation for Patient<'_, R> {
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
     }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
+    }
 }
 
 /// A relation with parameter `index` held at `value`: the best fit of the others there
@@ -204,6 +207,48 @@ impl<R: Relation> Relation for Pinned<'_, R> {
     }
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
+    }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
+    }
+}
+
+/// A relation with the parameters of `freed` out of their bands in every search space it
+/// offers: the model already extended by named effects, against which a further effect is
+/// judged (forward selection) and which is itself the baseline of that test.
+pub struct Freed<'r, R> {
+    /// The relation.
+    pub relation: &'r R,
+    /// The releases already granted.
+    pub freed: Vec<Release>,
+}
+
+impl<R: Relation> Relation for Freed<'_, R> {
+    fn specs(&self, release: Release) -> Vec<ParamSpec> {
+        let mut specs = self.relation.specs(release);
+        for r in &self.freed {
+            for (s, f) in specs.iter_mut().zip(self.relation.specs(*r)) {
+                if f.band.is_none() && s.band.is_some() {
+                    *s = f;
+                }
+            }
+        }
+        specs
+    }
+    fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
+        self.relation.residuals(values, rows)
+    }
+    fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
+        self.relation.released(release)
+    }
+    fn patience(&self) -> usize {
+        self.relation.patience()
+    }
+    fn facts(&self) -> &LogFacts {
+        self.relation.facts()
+    }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
     }
 }
 

@@ -87,6 +87,17 @@ pub struct Tested {
     pub evidence: String,
     /// How it extends the model.
     pub extension: Extension,
+    /// Standard error of each parameter in `parameters` that has one (SI; infinite where
+    /// the log leaves it unbounded).
+    pub standard_errors: Vec<(&'static str, f64)>,
+    /// The release a relation's test freed (`Nothing` for a line's), and the released fit
+    /// with the residuals' variance it was weighed with: the baseline of the effects
+    /// judged after it.
+    pub release: Release,
+    /// The released fit, for a relation's test.
+    pub fit: Option<Calibration>,
+    /// Effects the log cannot tell this one from.
+    pub ambiguous_with: Vec<&'static str>,
 }
 
 /// The catalogue's effect a release tests, the indices of the parameters it may release
@@ -173,6 +184,22 @@ pub fn from_release<R: Relation>(
         weighed_sse(relation, &test.baseline.values, validation, test.scale)
             - weighed_sse(relation, &test.fitted.values, validation, test.scale)
     });
+    // Each reported parameter's spread at one standard error of the coordinate it was
+    // searched in (the catalogue's value moves with the search value one to one but for an
+    // additive nominal: the leakage's, the cylinder's friction levels).
+    let standard_errors = parameters
+        .iter()
+        .zip(&indices)
+        .map(|((name, reported), &i)| {
+            let spread = released_spread(test, &specs, i);
+            // The bulk modulus is reported at the rig file's volume: the same ratio.
+            let scale = match test.release {
+                Release::BulkModulus => reported / specs[i].value(test.fitted.u[i]),
+                _ => 1.0,
+            };
+            (*name, spread * scale)
+        })
+        .collect();
     Tested {
         effect,
         parameters,
@@ -183,6 +210,26 @@ pub fn from_release<R: Relation>(
         veto: None,
         evidence: release_evidence(test, &indices, &specs, &base_specs),
         extension,
+        standard_errors,
+        release: test.release,
+        fit: Some(Calibration {
+            fitted: test.fitted.clone(),
+            scale: test.scale,
+        }),
+        ambiguous_with: Vec::new(),
+    }
+}
+
+/// The spread of parameter `i`'s value at one standard error of its search coordinate
+/// (infinite where the log does not bound it). [unit of the parameter]
+fn released_spread(test: &ReleaseTest, specs: &[ParamSpec], i: usize) -> f64 {
+    let u = test.fitted.u[i];
+    let se = test.fitted.standard_error(i, 1.0);
+    let spread = 0.5 * (specs[i].value(u + se) - specs[i].value(u - se)).abs();
+    if spread.is_finite() {
+        spread
+    } else {
+        f64::INFINITY
     }
 }
 
@@ -201,10 +248,8 @@ fn release_evidence(
     let released: Vec<String> = indices
         .iter()
         .map(|&i| {
-            let u = test.fitted.u[i];
-            let value = specs[i].value(u);
-            let se = test.fitted.standard_error(i, 1.0);
-            let spread = (specs[i].value(u + se) - value).abs();
+            let value = specs[i].value(test.fitted.u[i]);
+            let spread = released_spread(test, specs, i);
             // A direction the log leaves flat has no finite error: above the precharge
             // p₀ the gas's capacitance V₀·p₀^(1/n)/(n·p^(1+1/n)) sets p₀ against V₀.
             let error = if spread.is_finite() && spread <= SPREAD_SHOWN * value.abs() {
@@ -363,6 +408,11 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         f.lambda,
         f.dof
     );
+    let standard_errors = parameters
+        .iter()
+        .filter(|(name, _)| !matches!(*name, "order" | "pistons" | "phase_rad"))
+        .map(|(name, v)| (*name, se * v.abs() / a.max(f64::MIN_POSITIVE)))
+        .collect();
     Tested {
         effect: f.effect.name(),
         parameters,
@@ -373,6 +423,10 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         veto: None,
         evidence,
         extension: Extension::TorqueLine(f),
+        standard_errors,
+        release: Release::Nothing,
+        fit: None,
+        ambiguous_with: Vec::new(),
     }
 }
 
@@ -394,5 +448,9 @@ fn dead_time_verdict(f: DeadTimeFit, validation_gain: Option<f64>, windows: usiz
         veto: None,
         evidence,
         extension: Extension::CurrentLines(f),
+        standard_errors: vec![("dead_time_s", se_scale)],
+        release: Release::Nothing,
+        fit: None,
+        ambiguous_with: Vec::new(),
     }
 }

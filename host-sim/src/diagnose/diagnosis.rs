@@ -53,8 +53,15 @@ pub struct Cause {
     pub score: f64,
     /// Fitted parameters, by the catalogue's parameter names (SI).
     pub parameters: BTreeMap<String, f64>,
+    /// Standard error of each fitted parameter that has one (SI, infinite where the log
+    /// does not bound it) — beyond the contract, for trends over many logs.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub standard_errors: BTreeMap<String, f64>,
     /// One line saying why.
     pub evidence: String,
+    /// Effects the log cannot tell this one from (the evidence says which test would).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ambiguous_with: Vec<String>,
 }
 
 /// The extended model's fit.

@@ -44,6 +44,9 @@ pub const STEADY_SPREAD: f64 = 0.25;
 /// (over one revolution orders k and k ± 1 are orthogonal). [1]
 pub const STEADY_MIN_REVOLUTIONS: f64 = 1.0;
 
+/// Half-width of the piston position's smoothing. [s]
+pub const POSITION_SMOOTHING_S: f64 = 10e-3;
+
 /// Fraction of the largest second differences left out of the noise estimate (steps and
 /// transients, not noise). [1]
 const NOISE_TRIM: f64 = 0.02;
@@ -78,8 +81,18 @@ pub struct LogFacts {
     pub angle_logged: bool,
     /// Low-side (port B) pressure: logged, or the rig's fill pressure. [Pa]
     pub p_low_pa: Vec<f64>,
+    /// The fill (boost) level the ports' check valves hold them at, as the port transducers
+    /// read it: the median over the rows of the lower of the two port pressures (the
+    /// unloaded port sits there), or the rig's fill pressure less the check valve's
+    /// cracking when the low side is not logged. [Pa]
+    pub fill_pa: f64,
     /// Whether the piston moves (`x_m` logged and travelling).
     pub piston_moves: bool,
+    /// The logged piston position smoothed over ±[`POSITION_SMOOTHING_S`] (quadratic
+    /// Savitzky–Golay), when the piston moves: the volume balance multiplies the position by
+    /// the oil's stiffness A·β/V, 14 kPa per micrometre of a 71 cm² piston, so the
+    /// transducer's noise would otherwise dominate the pressure it predicts. [m]
+    pub x_smooth_m: Option<Vec<f64>>,
     /// Whether the piston moves but `x_m` is not logged: the pump displaced far more oil
     /// than the high side can store and leak ([`unseen_piston_motion`]). The pressure's
     /// volume balance then lacks its largest flow, and the hydraulic effects cannot be
@@ -114,6 +127,14 @@ impl LogFacts {
             .p_low_pa
             .clone()
             .unwrap_or_else(|| vec![rig.fill.pressure_pa; rows]);
+        let fill_pa = match log.p_low_pa.as_deref() {
+            Some(pl) => {
+                let mut lower: Vec<f64> = log.p_pa.iter().zip(pl).map(|(a, b)| a.min(*b)).collect();
+                lower.sort_by(f64::total_cmp);
+                lower[lower.len() / 2]
+            }
+            None => rig.fill.pressure_pa - rig.fill.check_cracking_pa,
+        };
         let piston_moves = log.x_m.as_deref().is_some_and(|x| {
             let (lo, hi) = x
                 .iter()
@@ -122,9 +143,12 @@ impl LogFacts {
                 });
             hi - lo > MOVING_PISTON_TRAVEL_M
         });
+        let x_smooth_m =
+            log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
+                savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
+            });
         let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, &p_low_pa, rig);
-        let t_half = t[0] + 0.5 * (t[rows - 1] - t[0]);
-        let split = t.partition_point(|x| *x < t_half).clamp(1, rows - 1);
+        let split = segment_split(t, &theta_rad, period_s, rig);
         let start = t
             .partition_point(|x| *x < t[0] + START_SKIP_S)
             .min(split / 4);
@@ -152,7 +176,9 @@ impl LogFacts {
             theta_rad,
             angle_logged,
             p_low_pa,
+            fill_pa,
             piston_moves,
+            x_smooth_m,
             piston_unseen,
             split,
             start,
@@ -197,6 +223,65 @@ impl LogFacts {
     }
 }
 
+/// Farthest the boundary between the identification and the validation segment moves
+/// from the log's middle, as a fraction of its duration. [1]
+pub const SPLIT_REACH: f64 = 0.2;
+
+/// The first row of the validation segment: the log's middle, unless the steady rotation
+/// slow enough to resolve every angle-locked line (the slot order below a third of the
+/// log's rate) sits mostly on one side of it. A staircase or step whose first level is
+/// reached at the speed limit holds all its slow rotation in its second half, and a line
+/// effect could then be neither fitted nor checked: the boundary moves, within
+/// [`SPLIT_REACH`] of the middle, to the end of the slow window that leaves the lesser side
+/// the most such revolutions (at least twice what the middle leaves it).
+fn segment_split(t: &[f64], theta: &[f64], period_s: f64, rig: &Rig) -> usize {
+    let rows = t.len();
+    let at = |f: f64| {
+        let t_f = t[0] + f * (t[rows - 1] - t[0]);
+        t.partition_point(|x| *x < t_f).clamp(1, rows - 1)
+    };
+    let highest = rig
+        .motor
+        .cogging_fundamental_order()
+        .max(6 * rig.motor.pole_pairs) as f64;
+    let limit = 2.0 * PI / period_s / 3.0 / highest;
+    let slow: Vec<SteadyWindow> = steady_windows(t, theta, period_s)
+        .into_iter()
+        .filter(|w| w.speed_rad_s.abs() < limit)
+        .collect();
+    let lesser = |split: usize| {
+        let (mut a, mut b) = (0.0, 0.0);
+        for w in &slow {
+            if w.rows.end <= split {
+                a += w.revolutions;
+            } else if w.rows.start >= split {
+                b += w.revolutions;
+            }
+        }
+        f64::min(a, b)
+    };
+    let middle = at(0.5);
+    let (lo, hi) = (at(0.5 - SPLIT_REACH), at(0.5 + SPLIT_REACH));
+    let (best, score) = slow
+        .iter()
+        .map(|w| w.rows.end)
+        .filter(|s| (lo..=hi).contains(s))
+        .map(|s| (s, lesser(s)))
+        .fold((middle, lesser(middle)), |b, c| {
+            let closer = c.0.abs_diff(middle) < b.0.abs_diff(middle);
+            if c.1 > b.1 || (c.1 == b.1 && closer) {
+                c
+            } else {
+                b
+            }
+        });
+    if score > 2.0 * lesser(middle) && score >= STEADY_MIN_REVOLUTIONS {
+        best
+    } else {
+        middle
+    }
+}
+
 /// Rows spanning `seconds` at the sampling `period_s`, at least `min_rows`: the spans of
 /// differences and fits are set in time, so a faster log is not differentiated over a
 /// shorter interval.
@@ -207,6 +292,33 @@ pub fn rows_spanning(seconds: f64, period_s: f64, min_rows: usize) -> usize {
     } else {
         min_rows
     }
+}
+
+/// `y` smoothed by the quadratic Savitzky–Golay filter of half-width `m` rows (exact on a
+/// parabola; the rows within `m` of either end keep a narrower window).
+pub fn savitzky_golay_smooth(y: &[f64], m: usize) -> Vec<f64> {
+    let n = y.len();
+    let weights = |m: usize| -> Vec<f64> {
+        let mf = m as f64;
+        let den = (2.0 * mf - 1.0) * (2.0 * mf + 1.0) * (2.0 * mf + 3.0);
+        (0..=2 * m)
+            .map(|i| {
+                let j = i as f64 - mf;
+                3.0 * (3.0 * mf * mf + 3.0 * mf - 1.0 - 5.0 * j * j) / den
+            })
+            .collect()
+    };
+    let full = weights(m);
+    (0..n)
+        .map(|k| {
+            let h = m.min(k).min(n - 1 - k);
+            if h == 0 {
+                return y[k];
+            }
+            let w = if h == m { full.clone() } else { weights(h) };
+            w.iter().enumerate().map(|(i, c)| c * y[k + i - h]).sum()
+        })
+        .collect()
 }
 
 /// Median of the sampling intervals of `t` (at least two rows). [s]

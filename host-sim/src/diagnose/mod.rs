@@ -43,6 +43,7 @@ pub mod predictions;
 mod release_tests;
 pub mod report;
 pub mod result;
+pub mod selection;
 pub mod signatures;
 pub mod spectrum;
 pub mod stick;

@@ -28,7 +28,7 @@ pub(super) fn assemble(
     rel: &Relations<'_>,
     cal: &Calibrations,
     tested: Vec<Tested>,
-    named: Option<usize>,
+    named: Vec<usize>,
     baseline: BTreeMap<&'static str, Vec<f64>>,
     extended: BTreeMap<&'static str, Vec<f64>>,
 ) -> Analysis {
@@ -53,10 +53,14 @@ pub(super) fn assemble(
         })
         .collect();
     let (hcal, mcal) = (&cal.hydraulic, &cal.mechanical);
-    let causes = causes(&tested, named, &calibration_summary(hcal, mcal, facts));
-    let named_effect = named.map(|i| tested[i].effect.to_string());
+    let causes = causes(&tested, &named, &calibration_summary(hcal, mcal, facts));
+    let named_effects: Vec<String> = named
+        .iter()
+        .map(|&i| tested[i].effect.to_string())
+        .collect();
     let mut order_idx: Vec<usize> = (0..tested.len()).collect();
-    order_idx.sort_by(|a, b| rank_key(&tested, named, *b).total_cmp(&rank_key(&tested, named, *a)));
+    order_idx
+        .sort_by(|a, b| rank_key(&tested, &named, *b).total_cmp(&rank_key(&tested, &named, *a)));
     let tested: Vec<Tested> = order_idx.into_iter().map(|i| tested[i].clone()).collect();
     let t = &log.t_s;
     let n = facts.rows;
@@ -71,7 +75,7 @@ pub(super) fn assemble(
         causes,
         calibration: calibration_values(rel, cal),
         extended: Extended {
-            effects: named_effect.into_iter().collect(),
+            effects: named_effects,
             fit_percent: ext_fit.fit_percent,
             rmse_pa: ext_fit.rmse_pa,
             fit_percent_by_signal: ext_fit.fit_percent_by_signal,
@@ -134,11 +138,11 @@ fn calibration_values(
     .collect()
 }
 
-/// The sort key that ranks the tested effects: the named one first, then by Λ over its
-/// threshold.
-fn rank_key(tested: &[Tested], named: Option<usize>, i: usize) -> f64 {
-    if Some(i) == named {
-        return f64::INFINITY;
+/// The sort key that ranks the tested effects: the named ones first, in their order, then
+/// by Λ over its threshold.
+fn rank_key(tested: &[Tested], named: &[usize], i: usize) -> f64 {
+    if let Some(k) = named.iter().position(|&j| j == i) {
+        return f64::MAX - k as f64 * 1e300;
     }
     tested[i].lambda / threshold(tested[i].dof)
 }
@@ -158,9 +162,9 @@ fn calibration_summary(h: &Calibration, m: &Calibration, facts: &LogFacts) -> St
     )
 }
 
-/// The contract's ranked causes: the named effect (or `none`) first, then every other
+/// The contract's ranked causes: the named effects (or `none`) first, then every other
 /// effect once, by strength, each with why it was not named.
-fn causes(tested: &[Tested], named: Option<usize>, none_why: &str) -> Vec<Cause> {
+fn causes(tested: &[Tested], named: &[usize], none_why: &str) -> Vec<Cause> {
     let cause = |t: &Tested, note: Option<String>| Cause {
         effect: t.effect.to_string(),
         score: t.lambda,
@@ -169,23 +173,30 @@ fn causes(tested: &[Tested], named: Option<usize>, none_why: &str) -> Vec<Cause>
             .iter()
             .map(|(k, v)| (k.to_string(), *v))
             .collect(),
+        standard_errors: t
+            .standard_errors
+            .iter()
+            .map(|(k, v)| (k.to_string(), *v))
+            .collect(),
         evidence: match note {
             Some(n) => format!("{}; {n}", t.evidence),
             None => t.evidence.clone(),
         },
+        ambiguous_with: t.ambiguous_with.iter().map(|s| s.to_string()).collect(),
     };
     let none = |score: f64, why: String| Cause {
         effect: "none".into(),
         score,
         parameters: BTreeMap::new(),
+        standard_errors: BTreeMap::new(),
         evidence: why,
+        ambiguous_with: Vec::new(),
     };
-    let mut out = Vec::new();
-    match named {
-        Some(i) => out.push(cause(&tested[i], None)),
-        None => out.push(none(0.0, none_why.to_string())),
+    let mut out: Vec<Cause> = named.iter().map(|&i| cause(&tested[i], None)).collect();
+    if named.is_empty() {
+        out.push(none(0.0, none_why.to_string()));
     }
-    let mut rest: Vec<usize> = (0..tested.len()).filter(|i| Some(*i) != named).collect();
+    let mut rest: Vec<usize> = (0..tested.len()).filter(|i| !named.contains(i)).collect();
     rest.sort_by(|a, b| rank_key(tested, named, *b).total_cmp(&rank_key(tested, named, *a)));
     for i in rest {
         if out.iter().any(|c| c.effect == tested[i].effect) {
@@ -193,8 +204,8 @@ fn causes(tested: &[Tested], named: Option<usize>, none_why: &str) -> Vec<Cause>
         }
         out.push(cause(&tested[i], why_not(&tested[i])));
     }
-    if named.is_some() {
-        out.push(none(0.0, "the named effect qualifies".into()));
+    if !named.is_empty() {
+        out.push(none(0.0, "the named effects qualify".into()));
     }
     out
 }

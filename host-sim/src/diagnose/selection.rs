@@ -1,0 +1,170 @@
+//! Stage 5 of the diagnosis: the set of effects the log convicts, several at once.
+//!
+//! The parity relations are structured residuals (Gertler): the hydraulic relation reads
+//! the pressure from the logged shaft angle and is blind to the motor; the mechanical one
+//! reads the torque balance with the angle-locked lines projected out; each line lives at
+//! its own order of the shaft angle; the cylinder's force balance and the stator voltages
+//! are relations of their own. An effect acting on one of them leaves the others' tests
+//! as they were, so each relation (each line) is judged on its own:
+//!
+//! - **One relation, several effects: forward selection.** On the hydraulic relation the
+//!   qualifying release with the largest Λ ([`super::decision`]) joins the model; every
+//!   other release is tested again against the model so extended (its parameter freed
+//!   beside the named ones, [`Freed`]), the best qualifying one joins, until none does.
+//!   With two or more named, each is judged once more against the model extended by all
+//!   the others (a backward check): one that the others explain is dropped.
+//! - **The other relations and the lines**: every effect that qualifies against the
+//!   calibrated baseline, once per effect (the pump's ripple at its best piston count;
+//!   the dead time and the flux harmonics, which share the lines at 6·p_n, through the
+//!   veto of [`apply_vetoes`]).
+//!
+//! The named effects are ranked by Λ over its χ² threshold, the strongest first.
+
+use super::analysis::Relations;
+use super::calibration::{calibrate, test_release, Calibration, Freed, Relation, Release};
+use super::candidates::{from_release, Extension, Tested};
+use super::decision::{apply_vetoes, threshold, why_not};
+use plant_model::Rig;
+
+/// Which residual an effect's test reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Family {
+    Hydraulic,
+    Other,
+}
+
+fn family(t: &Tested) -> Family {
+    match t.extension {
+        Extension::Hydraulic(_) => Family::Hydraulic,
+        _ => Family::Other,
+    }
+}
+
+/// The effects named, as indices into `tested` (whose hydraulic entries are replaced by
+/// their tests against the model extended by the others), the strongest first; and the
+/// hydraulic relation's values with every named hydraulic effect released.
+pub(super) fn select(
+    rel: &Relations<'_>,
+    tested: &mut [Tested],
+    rig: &Rig,
+) -> (Vec<usize>, Option<Vec<f64>>) {
+    apply_vetoes(tested);
+    let mut named: Vec<usize> = Vec::new();
+    // Every relation but the hydraulic one, and every line: once per effect.
+    for (i, t) in tested.iter().enumerate() {
+        if family(t) != Family::Other || why_not(t).is_some() {
+            continue;
+        }
+        match named.iter().position(|&j| tested[j].effect == t.effect) {
+            Some(k) if tested[named[k]].lambda < t.lambda => named[k] = i,
+            Some(_) => {}
+            None => named.push(i),
+        }
+    }
+    let (hydraulic, values) = forward_hydraulic(rel, tested, rig);
+    named.extend(hydraulic);
+    named.sort_by(|a, b| strength(&tested[*b]).total_cmp(&strength(&tested[*a])));
+    (named, values)
+}
+
+/// Λ over its χ² threshold.
+fn strength(t: &Tested) -> f64 {
+    t.lambda / threshold(t.dof)
+}
+
+/// The hydraulic relation's forward selection and backward check; the named entries of
+/// `tested` and the relation's values with all of them released.
+fn forward_hydraulic(
+    rel: &Relations<'_>,
+    tested: &mut [Tested],
+    rig: &Rig,
+) -> (Vec<usize>, Option<Vec<f64>>) {
+    let relation = rel.patient(&rel.hydraulic);
+    let first_round: Vec<Tested> = tested.to_vec();
+    let mut pool: Vec<usize> = (0..tested.len())
+        .filter(|&i| family(&tested[i]) == Family::Hydraulic)
+        .collect();
+    let mut named: Vec<usize> = Vec::new();
+    let mut base: Option<Calibration> = None;
+    loop {
+        let best = pool
+            .iter()
+            .copied()
+            .filter(|&i| why_not(&tested[i]).is_none())
+            .max_by(|a, b| tested[*a].lambda.total_cmp(&tested[*b].lambda));
+        let Some(b) = best else { break };
+        named.push(b);
+        base = tested[b].fit.clone();
+        pool.retain(|&i| i != b);
+        let Some(base) = &base else { break };
+        if pool.is_empty() {
+            break;
+        }
+        let freed = Freed {
+            relation: &relation,
+            freed: named.iter().map(|&i| tested[i].release).collect(),
+        };
+        for &i in &pool {
+            tested[i] = judged(&freed, base, tested[i].release, rel, rig);
+        }
+    }
+    if named.len() < 2 {
+        return (named.clone(), base.map(|b| b.fitted.values));
+    }
+    // Backward: each named effect against the model extended by all the others.
+    let mut kept = named.clone();
+    for &a in &named {
+        let others: Vec<Release> = kept
+            .iter()
+            .filter(|&&i| i != a)
+            .map(|&i| tested[i].release)
+            .collect();
+        if others.len() == kept.len() {
+            continue;
+        }
+        let freed = Freed {
+            relation: &relation,
+            freed: others,
+        };
+        let with_others = calibrate(&freed, &rel.h_id);
+        let again = judged(&freed, &with_others, tested[a].release, rel, rig);
+        if why_not(&again).is_none() {
+            tested[a] = again;
+        } else {
+            kept.retain(|&i| i != a);
+            // Its first-round entry says why it is not named on its own.
+            tested[a] = first_round[a].clone();
+            tested[a].veto = Some(format!(
+                "the other named hydraulic effects explain it (against them: {})",
+                why_not(&again).unwrap_or_default()
+            ));
+        }
+    }
+    let freed = Freed {
+        relation: &relation,
+        freed: kept.iter().map(|&i| tested[i].release).collect(),
+    };
+    let values = match kept.as_slice() {
+        [] => None,
+        [one] => tested[*one].fit.as_ref().map(|f| f.fitted.values.clone()),
+        _ => Some(calibrate(&freed, &rel.h_id).fitted.values),
+    };
+    (kept, values)
+}
+
+/// `release` tested on `relation` (the model extended by its freed effects) against
+/// `base`, that model's calibration.
+fn judged<R: Relation>(
+    relation: &R,
+    base: &Calibration,
+    release: Release,
+    rel: &Relations<'_>,
+    rig: &Rig,
+) -> Tested {
+    let t = test_release(relation, &rel.h_id, release, base);
+    let mut tested = from_release(relation, &t, &rel.h_val, rig);
+    tested
+        .evidence
+        .push_str(" (against the model with the other named effects)");
+    tested
+}
