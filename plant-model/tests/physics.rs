@@ -671,3 +671,41 @@ fn dead_time_costs_one_dead_interval_per_pwm_period() {
         "{loss_average} vs {textbook}"
     );
 }
+
+#[test]
+fn pressure_sensor_lag_trails_a_ramp_by_one_time_constant() {
+    // A first-order lag τ·ṗ_s = p − p_s driven by a ramp settles to p − p_s = τ·ṗ. The pump
+    // turned at a fixed speed into the blocked cylinder ramps port A; time constants from
+    // twenty steps down to a fiftieth of one (where an explicit integration of the lag would
+    // diverge) all trail it by τ·ṗ.
+    for tau in [1e-3, 50e-6, 1e-6] {
+        let mut rig = quiet(Rig::nominal());
+        rig.cylinder.blocked = true;
+        rig.sensors.pressure.lag_time_constant_s = tau;
+        let mut plant = Plant::new(&rig, &InitialConditions::holding(&rig, 2e6), 1).unwrap();
+        let h = 50e-6;
+        let mut p = Vec::new();
+        let mut lag = Vec::new();
+        for _ in 0..400 {
+            plant.advance(h, &speed_drive(20.0));
+            let o = plant.observe();
+            p.push(o.p_a_pa);
+            lag.push(o.p_a_pa - o.p_sensor_pa);
+        }
+        // After 20 ms (twenty time constants of the slowest), against the central difference.
+        let k = 398;
+        let slope = (p[k + 1] - p[k - 1]) / (2.0 * h);
+        assert!(slope > 1e6, "τ = {tau}: the port ramps ({slope} Pa/s)");
+        let expected = tau * slope;
+        let err = (lag[k] - expected).abs() / expected;
+        eprintln!(
+            "τ = {tau}: p − p_s = {:.4e} Pa, τ·ṗ = {expected:.4e} Pa",
+            lag[k]
+        );
+        assert!(
+            err < 0.02,
+            "τ = {tau}: trails by {} Pa, τ·ṗ = {expected} Pa",
+            lag[k]
+        );
+    }
+}
