@@ -137,6 +137,8 @@ const PHI_TERMS: usize = 14;
 /// (pascals against cubic metres per second): the largest over the rows of |a_ii| plus the
 /// geometric means √|a_ij·a_ji| of the off-diagonal pairs, Gershgorin's bound in the basis
 /// that balances each pair.
+// The pairs a_rc, a_cr are read by index from both sides.
+#[allow(clippy::needless_range_loop)]
 fn size<const N: usize>(a: &Mat<N>) -> f64 {
     let mut worst = 0.0f64;
     for r in 0..N {

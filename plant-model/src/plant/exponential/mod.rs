@@ -149,6 +149,9 @@ struct BlockKey {
 }
 
 /// The hydraulic block's matrix functions.
+// Held once, in the history; boxing the larger variant would need an allocator, which this
+// `no_std` crate does without.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 enum BlockPhi {
     /// (p_A, q).
@@ -448,8 +451,8 @@ impl Plant {
     fn block_key(&mut self, h: f64, port: Port) -> BlockKey {
         let (v1, v2) = self.cylinder.volumes(self.x[ix::X]);
         let k = [self.beta / v1, self.beta / v2];
-        let free = !self.cylinder.blocked
-            && !(self.discrete.piston == Slip::Stuck && self.piston_friction.is_active());
+        let free = !(self.cylinder.blocked
+            || (self.discrete.piston == Slip::Stuck && self.piston_friction.is_active()));
         let open = port == Port::Open;
         if let Some(b) = &self.exp.block {
             let near = |a: f64, b: f64| libm::fabs(a - b) <= BLOCK_REBUILD * b;
