@@ -17,7 +17,7 @@ use firmware::config::Config;
 use firmware::parameters::ParamId;
 use firmware::Command;
 use indicatif::{ProgressBar, ProgressStyle};
-use plant_model::Rig;
+use plant_model::{Integrator, Rig};
 use std::time::{Duration, Instant};
 
 /// What a run produced.
@@ -35,6 +35,10 @@ pub struct Run {
     pub absorber_zeta: f64,
     /// Simulated seconds per wall-clock second.
     pub real_time_factor: f64,
+    /// Simulated seconds per second of the running thread's own CPU time (what the run
+    /// costs, whatever else the machine is doing; the wall-clock factor where the platform
+    /// has no thread clock).
+    pub cpu_real_time_factor: f64,
 }
 
 /// Options of a run.
@@ -53,6 +57,8 @@ pub struct RunOptions {
     /// controller before the run, and enabled, as the drive loads it from flash (`None`:
     /// uncompensated).
     pub compensation: Option<Feedforward>,
+    /// The plant's integration scheme (the exponential one by default).
+    pub integrator: Integrator,
 }
 
 /// The bench-log columns a run logs: the six required, the shaft angle, piston position,
@@ -130,6 +136,7 @@ pub fn run_with_config(
 ) -> Result<Run, String> {
     let mut cl =
         ClosedLoop::new(plant_rig, config, scenario, opt.seed).map_err(|e| e.to_string())?;
+    cl.plant_mut().set_integrator(opt.integrator);
     if let Some(table) = &opt.compensation {
         load_compensation(&mut cl, table)?;
     }
@@ -163,6 +170,7 @@ pub fn run_with_config(
         None
     };
     let started = Instant::now();
+    let cpu_started = thread_cpu_s();
     let mut k = 0u64;
     cl.run(opt.duration_s, every, |s| {
         let t = &s.telemetry;
@@ -197,6 +205,10 @@ pub fn run_with_config(
         b.finish_and_clear();
     }
     let wall = started.elapsed().as_secs_f64();
+    let cpu = match (cpu_started, thread_cpu_s()) {
+        (Some(a), Some(b)) => b - a,
+        _ => wall,
+    };
     let [theta, x, p_low, w_ref, iq_ref, ud, uq, udc] = cols;
     log.theta_m_rad = Some(theta);
     log.x_m = Some(x);
@@ -230,7 +242,26 @@ pub fn run_with_config(
         absorber_fn_hz: fn_hz,
         absorber_zeta: zeta,
         real_time_factor: opt.duration_s / wall.max(1e-9),
+        cpu_real_time_factor: opt.duration_s / cpu.max(1e-9),
     })
+}
+
+/// The calling thread's CPU time (user and system), if the platform has a thread clock. [s]
+#[cfg(unix)]
+fn thread_cpu_s() -> Option<f64> {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the call only writes it.
+    let r = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (r == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+}
+
+/// The calling thread's CPU time: none without a thread clock. [s]
+#[cfg(not(unix))]
+fn thread_cpu_s() -> Option<f64> {
+    None
 }
 
 #[cfg(test)]
@@ -252,6 +283,7 @@ mod tests {
                 progress: false,
                 metadata: Vec::new(),
                 compensation: None,
+                integrator: Default::default(),
             },
         )
         .unwrap();

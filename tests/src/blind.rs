@@ -201,6 +201,7 @@ impl Draw {
             progress: false,
             metadata: vec![("source".into(), "blind-suite".into())],
             compensation: None,
+            integrator: Default::default(),
         };
         let config = self
             .structure

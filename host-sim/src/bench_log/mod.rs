@@ -22,13 +22,14 @@
 //! ([`crate::output::Outputs`]): a failed write leaves no partial file.
 
 pub mod limits;
+mod number;
 pub mod replayable;
 
 use limits::{
     excerpt, line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_METADATA_BYTES,
     MAX_METADATA_LINES, MAX_ROWS, MAX_VALUES, MIN_SAMPLE_INTERVAL_S,
 };
-use std::fmt::Write as _;
+
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -792,37 +793,40 @@ pub fn to_bytes(log: &BenchLog) -> Result<Vec<u8>, BenchLogError> {
 /// What errors about a log held in memory name as its file.
 const IN_MEMORY: &str = "<in memory>";
 
-/// Writes `log` (assumed checked) to `w`.
+/// Writes `log` (assumed checked) to `w`: the metadata lines, the header, the rows. Names
+/// and numbers never need CSV quoting, so the rows are spelled directly, a block of them
+/// at a time.
 fn write_to(w: &mut dyn Write, log: &BenchLog) -> io::Result<()> {
     for (k, v) in &log.metadata {
         writeln!(w, "# {k}: {v}")?;
     }
     let columns: Vec<(Signal, &[f64])> = log.columns().collect();
-    let mut csv = csv::WriterBuilder::new().from_writer(w);
-    csv.write_record(columns.iter().map(|(s, _)| s.name()))?;
-    let mut field = String::with_capacity(32);
+    let names: Vec<&str> = columns.iter().map(|(s, _)| s.name()).collect();
+    writeln!(w, "{}", names.join(","))?;
+    let mut block: Vec<u8> = Vec::with_capacity(1 << 16);
     for row in 0..log.len() {
-        for (_, c) in &columns {
-            field.clear();
-            format_value(&mut field, c.get(row).copied().unwrap_or(f64::NAN));
-            csv.write_field(&field)?;
+        for (k, (_, c)) in columns.iter().enumerate() {
+            if k > 0 {
+                block.push(b',');
+            }
+            number::push_bytes(&mut block, c.get(row).copied().unwrap_or(f64::NAN));
         }
-        csv.write_record(None::<&[u8]>)?;
+        block.push(b'\n');
+        if block.len() >= 1 << 15 {
+            w.write_all(&block)?;
+            block.clear();
+        }
     }
-    csv.flush()
+    w.write_all(&block)?;
+    w.flush()
 }
 
-/// Shortest round-trip text of `v`: Rust's float formatting prints the fewest digits that
-/// parse back to the same f64; positional for ordinary magnitudes, exponent notation for
-/// very small or large ones (where positional would spell out dozens of zeros).
+/// Shortest round-trip text of `v`: the fewest digits that parse back to the same f64;
+/// positional for ordinary magnitudes, exponent notation for very small or large ones
+/// (where positional would spell out dozens of zeros) — Rust's float formatting, spelled
+/// faster ([`number`]).
 pub fn format_value(out: &mut String, v: f64) {
-    let a = v.abs();
-    // `write!` into a String cannot fail.
-    let _ = if a == 0.0 || (1e-5..1e16).contains(&a) {
-        write!(out, "{v}")
-    } else {
-        write!(out, "{v:e}")
-    };
+    number::push(out, v);
 }
 
 #[cfg(test)]

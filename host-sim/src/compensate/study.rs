@@ -104,6 +104,7 @@ fn learning_log(
             progress: false,
             metadata: vec![("source".into(), "compensation study".into())],
             compensation: None,
+            integrator: Default::default(),
         },
     )
     .map_err(CliError::Failed)?;

@@ -159,6 +159,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
                     progress: false,
                     metadata: m.clone(),
                     compensation: table.cloned(),
+                    integrator: Default::default(),
                 },
             )
         })
@@ -168,7 +169,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         runs.next()
             .unwrap_or_else(|| Err("run missing".into()))
             .map_err(CliError::Failed)
-            .and_then(converged)
+            .and_then(|r| converged(r, None))
     };
     let (with, without) = (next()?, next()?);
     let (with_ff, without_ff) = (next()?, next()?);

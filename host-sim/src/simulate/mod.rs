@@ -14,10 +14,10 @@ use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::{by_name, PROCEDURES, SCENARIOS};
 use plant_model::effects::{EffectError, EFFECT_NAMES};
-use plant_model::{Effect, Rig};
+use plant_model::{Effect, Integrator, Rig};
 use serde_json::json;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Log rate of the simulated bench logs. [Hz]
 pub const LOG_RATE_HZ: f64 = 2000.0;
@@ -63,6 +63,28 @@ pub struct SimulateArgs {
     /// Write a run summary as JSON, with the real-time factor (`-`: standard output).
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+    /// The plant's integration scheme: `exponential` (the default: exact winding and
+    /// hydraulic blocks, third-order exponential Adams–Bashforth), `rk4` (classical
+    /// Runge–Kutta at the PWM period, the scheme before it) or `rk4-quarter` (at a quarter of
+    /// the period, the accuracy reference).
+    #[arg(long, value_name = "NAME", default_value = "exponential", value_parser = integrator)]
+    pub integrator: Integrator,
+    /// Also run the same simulation with this scheme (not logged) and report both real-time
+    /// factors and their ratio (per second of the thread's CPU time, so that other work on
+    /// the machine does not bias it), measured in this process (`--json`'s `compared`).
+    #[arg(long, value_name = "NAME", value_parser = integrator)]
+    pub compare_integrator: Option<Integrator>,
+}
+
+/// An integration scheme by name.
+fn integrator(s: &str) -> Result<Integrator, String> {
+    Integrator::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = Integrator::NAMES.iter().map(|(n, _)| *n).collect();
+        format!(
+            "unknown integrator `{s}`: the integrators are {}",
+            names.join(", ")
+        )
+    })
 }
 
 /// A log rate: positive and at most the 20 kHz PWM rate the telemetry is sampled at. [Hz]
@@ -182,14 +204,21 @@ pub(crate) fn plant_rig(rig: &Rig, effects: &[Effect]) -> Result<Rig, CliError> 
 }
 
 /// `run` unless its state left the physical range: a rig the integration cannot follow
-/// (bad input, exit status 2) rather than a log of NaN.
-pub(crate) fn converged(run: Run) -> Result<Run, CliError> {
+/// (bad input, exit status 2) rather than a log of NaN. `rig_file` is the plant's rig file
+/// when one was given (the message points there, else at the rig and effects asked for).
+pub(crate) fn converged(run: Run, rig_file: Option<&Path>) -> Result<Run, CliError> {
     match first_unphysical(&run.log) {
         None => Ok(run),
-        Some((t, name, v)) => Err(CliError::BadInput(format!(
-            "the simulation diverged: `{name}` reached {v:e} at t = {t:.6} s; the rig's \
-             parameters make the model numerically unstable (check the rig file's values)"
-        ))),
+        Some((t, name, v)) => {
+            let check = match rig_file {
+                Some(f) => format!("check the values in the rig file `{}`", f.display()),
+                None => "check the rig's parameters and the effects asked for".into(),
+            };
+            Err(CliError::BadInput(format!(
+                "the simulation diverged: `{name}` reached {v:e} at t = {t:.6} s; the plant's \
+                 parameters make the model numerically unstable ({check})"
+            )))
+        }
     }
 }
 
@@ -292,6 +321,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             format!("{}", controller.absorber.precharge_pa),
         ),
         ("seed".into(), format!("{seed}")),
+        ("integrator".into(), args.integrator.name().into()),
     ];
     if let Some(path) = &args.plant_rig {
         metadata.push(("plant_rig".into(), path.display().to_string()));
@@ -313,44 +343,79 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             ),
         ));
     }
-    let r = run(
-        &plant,
-        &controller,
-        scenario,
-        &RunOptions {
-            duration_s: duration,
-            log_rate_hz: args.log_rate,
-            seed,
-            progress: true,
-            metadata,
-            compensation,
-        },
-    )
-    .map_err(CliError::Failed)
-    .and_then(converged)?;
+    let options = RunOptions {
+        duration_s: duration,
+        log_rate_hz: args.log_rate,
+        seed,
+        progress: true,
+        metadata,
+        compensation,
+        integrator: args.integrator,
+    };
+    let r = run(&plant, &controller, scenario, &options)
+        .map_err(CliError::Failed)
+        .and_then(|r| converged(r, args.plant_rig.as_deref()))?;
+    // The same run with the other scheme, for the ratio of their speeds in this process.
+    let compared = match args.compare_integrator {
+        Some(other) => {
+            let o = run(
+                &plant,
+                &controller,
+                scenario,
+                &RunOptions {
+                    integrator: other,
+                    progress: false,
+                    ..options
+                },
+            )
+            .map_err(CliError::Failed)
+            .and_then(|r| converged(r, args.plant_rig.as_deref()))?;
+            Some((other, o))
+        }
+        None => None,
+    };
     let mut outputs = Outputs::new();
     bench_log::stage(&mut outputs, "--out", out, &r.log)?;
     if let Some(json_path) = &args.json {
-        outputs.json(
-            "--json",
-            json_path,
-            &json!({
-                "scenario": scenario.name,
-                "duration_s": duration,
-                "rows": r.log.len(),
-                "out": out.display().to_string(),
-                "real_time_factor": r.real_time_factor,
-            }),
-        )?;
+        let mut summary = json!({
+            "scenario": scenario.name,
+            "duration_s": duration,
+            "rows": r.log.len(),
+            "out": out.display().to_string(),
+            "real_time_factor": r.real_time_factor,
+            "cpu_real_time_factor": r.cpu_real_time_factor,
+            "integrator": args.integrator.name(),
+        });
+        if let Some((other, o)) = &compared {
+            summary["compared"] = json!({
+                "integrator": other.name(),
+                "real_time_factor": o.real_time_factor,
+                "cpu_real_time_factor": o.cpu_real_time_factor,
+                "speedup": r.cpu_real_time_factor / o.cpu_real_time_factor,
+            });
+        }
+        outputs.json("--json", json_path, &summary)?;
     }
     outputs.commit()?;
     eprintln!(
-        "{}: {} rows over {duration} s written to {} ({:.0}× real time)",
+        "{}: {} rows over {duration} s written to {} ({:.0}× real time, {:.0}× per CPU second, \
+         {})",
         scenario.name,
         r.log.len(),
         out.display(),
-        r.real_time_factor
+        r.real_time_factor,
+        r.cpu_real_time_factor,
+        args.integrator.name()
     );
+    if let Some((other, o)) = &compared {
+        eprintln!(
+            "{}: {:.0}× per CPU second; {} is {:.2}× as fast",
+            other.name(),
+            o.cpu_real_time_factor,
+            args.integrator.name(),
+            r.cpu_real_time_factor / o.cpu_real_time_factor
+        );
+    }
     Ok(())
 }
 
