@@ -228,7 +228,9 @@ mod tests {
                 .iter()
                 .map(|(k, v)| (k.to_string(), *v))
                 .collect::<BTreeMap<_, _>>(),
+            standard_errors: BTreeMap::new(),
             evidence: String::new(),
+            ambiguous_with: Vec::new(),
         }
     }
 
