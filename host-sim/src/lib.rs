@@ -15,6 +15,7 @@
 //!   step log; [`can_commands`]: parameter changes as `cansend` lines and `candump` logs.
 //! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain.
 //! - [`watch`]: the drive's telemetry live in the terminal, and the bench log as it comes.
+//! - [`timestamp`]: the RFC 3339 times of logs and predictions.
 
 pub mod bench_log;
 pub mod can_commands;
@@ -30,6 +31,7 @@ pub mod rig_file;
 pub mod run;
 pub mod simulate;
 pub mod study;
+pub mod timestamp;
 pub mod tune;
 pub mod values;
 pub mod watch;
