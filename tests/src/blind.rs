@@ -199,6 +199,12 @@ fn tolerance_rig(s: &mut Stream) -> Rig {
     r
 }
 
+/// A bench of the nominal design built within its tolerances ([`tolerance_rig`]), drawn
+/// from a stream of its own seeded with `seed`: the fleet generator's drives.
+pub fn seeded_tolerance_rig(seed: u64) -> Rig {
+    tolerance_rig(&mut Stream(Xoshiro256PlusPlus::seed_from_u64(seed)))
+}
+
 /// Total leakage conductance out of the high-pressure port of the nominal rig: pump
 /// internal and external, cylinder cross-piston. [(m³/s)/Pa]
 fn nominal_total_leakage() -> f64 {

@@ -7,6 +7,7 @@
 
 pub mod blind;
 pub mod campaign;
+pub mod fleet;
 pub mod fuzz;
 
 use closed_loop::{controller_config, ClosedLoop, Sample, Scenario};
