@@ -36,6 +36,7 @@ use runner::{Finished, Ran, Runner};
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use table::Row;
 
@@ -157,9 +158,19 @@ fn plan(
     })
 }
 
+/// What the table needs of an outcome: the findings, or why there are none. Only these
+/// are held for the whole run (a few kilobytes a log), never the diagnoses' JSON.
+fn findings_of(outcome: Outcome) -> Result<table::Findings, String> {
+    match outcome {
+        Outcome::Diagnosed(d) => table::findings(&d)
+            .ok_or_else(|| "the kept diagnosis is not eha diagnose's JSON".to_string()),
+        Outcome::BadInput(why) => Err(why),
+    }
+}
+
 /// What became of each distinct log: kept outcomes read back or made now, failures.
 struct Results {
-    by_hash: BTreeMap<String, Result<Outcome, String>>,
+    by_hash: BTreeMap<String, Result<table::Findings, String>>,
     diagnosed_now: usize,
     reused: usize,
     worker_peak_rss: Option<u64>,
@@ -174,7 +185,7 @@ fn diagnose_all(
     runner: &Runner,
     jobs: usize,
 ) -> Result<Results, CliError> {
-    let mut by_hash: BTreeMap<String, Result<Outcome, String>> = BTreeMap::new();
+    let mut by_hash: BTreeMap<String, Result<table::Findings, String>> = BTreeMap::new();
     let mut to_run: Vec<(&str, &Path)> = Vec::new();
     for (e, h) in entries.iter().zip(hashes) {
         let Ok(h) = h else { continue };
@@ -183,7 +194,7 @@ fn diagnose_all(
         }
         match cache::load(out, h, ctx) {
             Some(o) => {
-                by_hash.insert(h.clone(), Ok(o));
+                by_hash.insert(h.clone(), findings_of(o));
             }
             None => to_run.push((h, &e.path)),
         }
@@ -191,19 +202,33 @@ fn diagnose_all(
     let reused = by_hash.len();
     let bar = crate::output::progress::steps(to_run.len() as u64, "diagnosing".into());
     let logs: Vec<&Path> = to_run.iter().map(|(_, p)| *p).collect();
-    let finished = runner::run_all(runner, &logs, jobs, &|_: &Finished| bar.inc(1));
+    // Each outcome is kept the moment it is known: a run stopped after hours keeps all
+    // that it finished.
+    let store_error: Mutex<Option<CliError>> = Mutex::new(None);
+    let keep = |i: usize, f: &Finished| {
+        bar.inc(1);
+        if let Ran::Kept(o) = &f.ran {
+            let h = to_run[i].0;
+            if let Err(source) = cache::store(out, h, ctx, o) {
+                if let Ok(mut e) = store_error.lock() {
+                    e.get_or_insert(CliError::Write {
+                        file: cache::record_path(out, h),
+                        source,
+                    });
+                }
+            }
+        }
+    };
+    let finished = runner::run_all(runner, &logs, jobs, &keep);
     bar.finish_and_clear();
+    if let Some(e) = store_error.into_inner().ok().flatten() {
+        return Err(e);
+    }
     let mut worker_peak_rss = None;
     for ((h, _), f) in to_run.iter().zip(finished) {
         worker_peak_rss = worker_peak_rss.max(f.peak_rss_bytes);
         let r = match f.ran {
-            Ran::Kept(o) => {
-                cache::store(out, h, ctx, &o).map_err(|source| CliError::Write {
-                    file: cache::record_path(out, h),
-                    source,
-                })?;
-                Ok(o)
-            }
+            Ran::Kept(o) => findings_of(o),
             Ran::Failed(why) => Err(why),
         };
         by_hash.insert(h.to_string(), r);
@@ -225,13 +250,11 @@ fn rows(entries: Vec<Entry>, hashes: Vec<Result<String, String>>, r: &Results) -
             let (sha256, result) = match h {
                 Err(why) => (None, Err(why)),
                 Ok(h) => {
-                    let result = match r.by_hash.get(&h) {
-                        Some(Ok(Outcome::Diagnosed(d))) => table::findings(d).ok_or_else(|| {
-                            "the kept diagnosis is not eha diagnose's JSON".to_string()
-                        }),
-                        Some(Ok(Outcome::BadInput(why))) | Some(Err(why)) => Err(why.clone()),
-                        None => Err("not diagnosed".to_string()),
-                    };
+                    let result = r
+                        .by_hash
+                        .get(&h)
+                        .cloned()
+                        .unwrap_or_else(|| Err("not diagnosed".to_string()));
                     (Some(h), result)
                 }
             };

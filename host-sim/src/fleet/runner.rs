@@ -56,13 +56,14 @@ pub struct Finished {
 
 static STAGED: AtomicU32 = AtomicU32::new(0);
 
-/// Diagnoses every log of `logs` with `workers` children at a time; `done` is called as
-/// each finishes (for progress). Results in the order of `logs`.
+/// Diagnoses every log of `logs` with `workers` children at a time; `done` is called with
+/// the log's index as each finishes (to keep its outcome at once, and for progress).
+/// Results in the order of `logs`.
 pub fn run_all(
     runner: &Runner,
     logs: &[&Path],
     workers: usize,
-    done: &(dyn Fn(&Finished) + Sync),
+    done: &(dyn Fn(usize, &Finished) + Sync),
 ) -> Vec<Finished> {
     let next = AtomicUsize::new(0);
     let workers = workers.clamp(1, logs.len().max(1));
@@ -76,7 +77,7 @@ pub fn run_all(
                         let i = next.fetch_add(1, Ordering::Relaxed);
                         let Some(log) = logs.get(i) else { break };
                         let f = runner.diagnose(log);
-                        done(&f);
+                        done(i, &f);
                         mine.push((i, f));
                     }
                     mine
