@@ -325,7 +325,7 @@ mod tests {
             "path,drive,recorded_at,comment\nlogs/1.csv,D0,,moved\n",
         )
         .unwrap();
-        let e = gather(&[logs.clone()], Some(&manifest), &out).unwrap();
+        let e = gather(std::slice::from_ref(&logs), Some(&manifest), &out).unwrap();
         let names: Vec<String> = e
             .iter()
             .map(|e| format!("{} {:?}", e.path.display(), e.drive))
@@ -344,7 +344,7 @@ mod tests {
         assert!(e.iter().all(|e| e.problem.is_none()));
         // A bad time in a log is that log's problem; in the manifest, a bad argument.
         std::fs::write(logs.join("1.csv"), head("D2", "yesterday")).unwrap();
-        let e = gather(&[logs.clone()], None, &out).unwrap();
+        let e = gather(std::slice::from_ref(&logs), None, &out).unwrap();
         let bad = e.iter().find(|e| e.path.ends_with("1.csv")).unwrap();
         assert!(bad.problem.as_deref().unwrap().contains("RFC 3339"));
         std::fs::write(&manifest, "path,recorded_at\nlogs/1.csv,soon\n").unwrap();
