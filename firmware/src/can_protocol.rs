@@ -23,6 +23,7 @@
 //! | `0x180` | drive → host | `Status`       | 8   | see below                               |
 //! | `0x190` | drive → host | `Reject`       | 8   | see below                               |
 //! | `0x1A0` | drive → host | `Parameter`    | 8   | see below                               |
+//! | `0x1B0` | drive → host | `Diagnostics`  | 8   | see below                               |
 //! | `0x200` | host → drive | `SetParameter` | 5   | `u8` parameter id, `f32` value in the parameter's unit |
 //! | `0x210` | host → drive | `GetParameter` | 1   | `u8` parameter id                       |
 //! | `0x220` | host → drive | `SaveParameters` | 0 | — (allowed in Disabled only)            |
@@ -107,6 +108,15 @@
 //! | 0     | `u8`  | parameter id                                                     |
 //! | 1‥4   | `f32` | value in use, in the parameter's unit                            |
 //! | 5‥7   | —     | reserved, `0`                                                    |
+//!
+//! # Diagnostics (`0x1B0 + node`, DLC 8)
+//!
+//! Sent once a second, unsolicited: what the drive measures of itself for the bench.
+//!
+//! | bytes | type  | content                                                          |
+//! |-------|-------|------------------------------------------------------------------|
+//! | 0‥3   | `u32` | stack high-water mark since power-up: the deepest the stack has reached, in bytes (painted at boot, scanned since) |
+//! | 4‥7   | `u32` | the stack's size: the RAM below the static data, in bytes        |
 
 use crate::compensation::record::RecordError;
 use crate::compensation::CompensationError;
@@ -154,6 +164,8 @@ pub mod id {
     pub const REJECT: u16 = 0x190;
     /// `Parameter` reply.
     pub const PARAMETER: u16 = 0x1A0;
+    /// `Diagnostics` reply.
+    pub const DIAGNOSTICS: u16 = 0x1B0;
     /// `SetParameter` command.
     pub const SET_PARAMETER: u16 = 0x200;
     /// `GetParameter` command.
@@ -645,6 +657,15 @@ impl Status {
     }
 }
 
+/// The drive's measurements of itself, sent once a second.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Diagnostics {
+    /// Stack high-water mark since power-up. [bytes]
+    pub stack_peak_bytes: u32,
+    /// The stack's size. [bytes]
+    pub stack_size_bytes: u32,
+}
+
 /// A refused command, in wire units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rejection {
@@ -859,6 +880,8 @@ pub enum Reply {
         /// Its value. [the parameter's unit]
         value: f32,
     },
+    /// The drive's measurements of itself.
+    Diagnostics(Diagnostics),
 }
 
 /// A frame the codec cannot turn into a message.
@@ -1135,6 +1158,11 @@ pub fn encode_reply(reply: &Reply, node: NodeId) -> Frame {
             write_f32(&mut data, 1, value);
             id::PARAMETER
         }
+        Reply::Diagnostics(d) => {
+            data[..4].copy_from_slice(&d.stack_peak_bytes.to_le_bytes());
+            data[4..].copy_from_slice(&d.stack_size_bytes.to_le_bytes());
+            id::DIAGNOSTICS
+        }
     };
     Frame {
         id: node.id(base),
@@ -1147,7 +1175,7 @@ pub fn encode_reply(reply: &Reply, node: NodeId) -> Frame {
 pub fn decode_reply(frame: &Frame, node: NodeId) -> Result<Reply, DecodeError> {
     let frame_node = (frame.id & NODE_MASK) as u8;
     let base = frame.id & !NODE_MASK;
-    if base != id::STATUS && base != id::REJECT && base != id::PARAMETER {
+    if ![id::STATUS, id::REJECT, id::PARAMETER, id::DIAGNOSTICS].contains(&base) {
         return Err(DecodeError::UnknownFunction { id: frame.id });
     }
     if frame_node != node.0 {
@@ -1164,6 +1192,11 @@ pub fn decode_reply(frame: &Frame, node: NodeId) -> Result<Reply, DecodeError> {
             speed_drad_s: i16::from_le_bytes([b4, b5]),
             last_command: b6,
             sequence: b7,
+        }))
+    } else if base == id::DIAGNOSTICS {
+        Ok(Reply::Diagnostics(Diagnostics {
+            stack_peak_bytes: u32::from_le_bytes([b0, b1, b2, b3]),
+            stack_size_bytes: u32::from_le_bytes([b4, b5, b6, b7]),
         }))
     } else if base == id::PARAMETER {
         if b5 != 0 || b6 != 0 || b7 != 0 {

@@ -24,10 +24,11 @@ pub enum Response {
 
 /// Serves `request` on `controller`.
 ///
-/// `SaveParameters` is allowed in Disabled only: on the G474 a flash erase stalls every
-/// instruction fetch for about 25 ms, the current loop included, which only a drive with
-/// its bridge off can afford. It is refused with reason `NotAllowed` and the bound `0`
-/// (the Disabled mode code) otherwise.
+/// `SaveParameters` is allowed in Disabled only: on the G474 a save blocks the tasks for
+/// about 50 ms (two page erases; the current loop runs on from the other flash bank), in
+/// which the command timeout and the CAN replies wait, which only a drive with its bridge
+/// off can afford. It is refused with reason `NotAllowed` and the bound `0` (the Disabled
+/// mode code) otherwise.
 pub fn serve(request: &Request, controller: &mut Controller) -> Response {
     match *request {
         Request::GetParameter { id } => Response::Reply(Reply::Parameter {

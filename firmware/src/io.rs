@@ -48,7 +48,8 @@ pub struct Outputs {
 }
 
 impl Outputs {
-    /// Bridge off, duties at 50 % (what the timer is left at).
+    /// Bridge off (the duties are not applied: the board's bridge writes compare 0 while
+    /// off, [`crate::bridge`]).
     pub const DISABLED: Outputs = Outputs {
         duties: [0.5; 3],
         pwm_enabled: false,

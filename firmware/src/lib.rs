@@ -13,6 +13,7 @@
 #![cfg_attr(not(test), no_std)]
 
 pub mod angle_grid;
+pub mod bridge;
 pub mod can_protocol;
 pub mod can_server;
 pub mod commissioning;
@@ -22,6 +23,7 @@ pub mod controller;
 pub mod current_loop;
 pub mod encoder;
 pub mod io;
+pub mod liveness;
 pub mod param_store;
 pub mod parameters;
 pub mod pi;
@@ -31,6 +33,7 @@ pub mod scaling;
 pub mod shunt;
 pub mod speed_loop;
 pub mod speed_observer;
+pub mod stack;
 pub mod step_test;
 pub mod supervisor;
 pub mod svpwm;

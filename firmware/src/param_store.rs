@@ -60,6 +60,8 @@
 //! a record whose values are out of their bounds or inconsistent, so the controller never
 //! starts from garbage.
 
+pub mod ecc;
+
 use crate::compensation::record::{self as table_record, CHUNK_MAX};
 use crate::config::Config;
 use crate::parameters::{self, COUNT, LEGACY_COUNT};

@@ -44,6 +44,25 @@ pub fn duty_to_compare(duty: f32, period: u16) -> u16 {
     ((product >> 15) as u16).min(period)
 }
 
+/// Auto-reload value of a centre-aligned PWM timer at `timer_hz` [Hz] for `pwm_hz` [Hz]:
+/// the counter runs 0 → ARR → 0, 2·ARR timer clocks per PWM period (RM0440, centre-aligned
+/// counting), so ARR = timer_hz / (2·pwm_hz), rounded to the nearest period. `None` when it
+/// does not fit the 16-bit register or is below 2.
+pub fn centre_aligned_arr(timer_hz: u32, pwm_hz: u32) -> Option<u16> {
+    let twice = 2 * u64::from(pwm_hz);
+    if twice == 0 {
+        return None;
+    }
+    let arr = (u64::from(timer_hz) + twice / 2) / twice;
+    u16::try_from(arr).ok().filter(|a| *a >= 2)
+}
+
+/// The PWM rate a centre-aligned timer at `timer_hz` [Hz] runs at with auto-reload value
+/// `arr`. [Hz]
+pub fn centre_aligned_pwm_hz(timer_hz: u32, arr: u16) -> f32 {
+    timer_hz as f32 / (2.0 * f32::from(arr.max(1)))
+}
+
 /// The 12-bit code of a threshold that a phase-current reading crosses at `trip_a` [A]
 /// flowing out of the motor terminal (negative in the current convention), for readings
 /// `zero_lsb` [counts] at 0 A and `a_per_lsb` [A/count]: `zero − trip/a_per_lsb`, rounded,
@@ -90,6 +109,21 @@ mod tests {
         assert_eq!(comparator_threshold_counts(2048.0, 100.0 / 4096.0, 60.0), 0);
         assert_eq!(comparator_threshold_counts(2048.0, 0.0, 1.0), 0);
         assert_eq!(comparator_threshold_counts(f32::NAN, 1.0, 1.0), 0);
+    }
+
+    #[test]
+    fn the_centre_aligned_period_is_twice_the_auto_reload_value() {
+        // 170 MHz / (2 · 20 kHz) = 4250 exactly; the edge-aligned formula's
+        // clocks − 1 = 4249 would give 170e6 / 8498 = 20 004.7 Hz.
+        assert_eq!(centre_aligned_arr(170_000_000, 20_000), Some(4250));
+        assert_eq!(centre_aligned_pwm_hz(170_000_000, 4250), 20_000.0);
+        assert!((centre_aligned_pwm_hz(170_000_000, 4249) - 20_004.7).abs() < 0.05);
+        // 16 kHz: 5312.5 rounds to 5313 (15 998.5 Hz, the nearest).
+        assert_eq!(centre_aligned_arr(170_000_000, 16_000), Some(5313));
+        // Too slow for 16 bits, too fast, or no rate at all.
+        assert_eq!(centre_aligned_arr(170_000_000, 1_000), None);
+        assert_eq!(centre_aligned_arr(170_000_000, 100_000_000), None);
+        assert_eq!(centre_aligned_arr(170_000_000, 0), None);
     }
 
     #[test]

@@ -6,15 +6,20 @@
 //! single precision) — and sends the controller's telemetry as defmt frames through the
 //! firmware's own [`firmware::TelemetryFrame::emit`], carried to the host by semihosting.
 //! Beside the loop it measures the instructions per call of the current-, speed- and
-//! pressure-loop steps with SysTick (see [`icount`]), and ends with one `PIL …` defmt line
-//! of figures and a semihosting exit code (0 when the run completed).
+//! pressure-loop steps with SysTick (see [`icount`]) and the stack's high-water mark (see
+//! [`stack`]), and ends with one `PIL …` defmt line of figures and a semihosting exit code
+//! (0 when the run completed).
 //!
 //! `cargo xtask test` builds it, runs it under `qemu-system-arm -icount shift=0`, decodes the
 //! frames with the ELF and turns them into a bench log with `eha ingest`.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
+mod firmware_paths;
+#[cfg(target_os = "none")]
 mod icount;
+#[cfg(target_os = "none")]
+mod stack;
 #[cfg(target_os = "none")]
 mod target;
 

@@ -1,7 +1,12 @@
 //! The PIL run on the target: the scenario in closed loop, telemetry out, the loop steps
 //! measured beside it, the figures and the exit code.
 
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
+
+use crate::firmware_paths;
 use crate::icount::{self, Tally};
+use crate::stack;
 use closed_loop::{by_name, controller_config, ClosedLoop};
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use defmt_semihosting as _;
@@ -23,6 +28,10 @@ const SEED: u64 = 1;
 /// Telemetry rate: the rate of the host simulator's bench logs (`eha simulate`), so the two
 /// logs have the same instants. [Hz]
 const LOG_RATE_HZ: f64 = 2000.0;
+/// Every this many periods the closed-loop step's own stack depth is measured.
+const STACK_BRACKET_EVERY: u64 = 50;
+/// The first this many telemetry frames have their stack depth measured.
+const STACK_BRACKET_FRAMES: u32 = 20;
 
 #[entry]
 fn main() -> ! {
@@ -47,7 +56,13 @@ fn run() -> Result<(), ()> {
     };
     let rig = Rig::nominal();
     let config = controller_config(&rig);
-    let mut cl = match ClosedLoop::new(&rig, &config, scenario, SEED) {
+    // The loop and the feed-forward live in static memory, as the firmware's controller
+    // does once installed. Building them is the harness's work, not the firmware's (the
+    // plant, a ClosedLoop around the controller, the test table): measured alone, and the
+    // run's high-water mark counts from after it.
+    let (built, compensation, setup_stack) = setup(&rig, &config, scenario);
+    stack::restart();
+    let cl = match built {
         Ok(cl) => cl,
         Err(e) => {
             defmt::error!("PIL: cannot build the loop: {}", defmt::Display2Format(&e));
@@ -62,7 +77,7 @@ fn run() -> Result<(), ()> {
     // controller saw (the ADC counts, the telemetry's angle, speeds and references): the
     // same code as inside `Controller::on_current_sample`, bracketed alone.
     let mut current = CurrentLoop::new(&config);
-    let Some(compensation) = feed_forward(&config) else {
+    let Some(compensation) = compensation else {
         defmt::error!("PIL: the feed-forward's test table was refused");
         return Err(());
     };
@@ -83,23 +98,40 @@ fn run() -> Result<(), ()> {
     // the angle (the sine table) and the space-vector modulator (with its division by U_dc).
     let (mut t_sin_cos, mut t_svpwm) = (Tally::default(), Tally::default());
     let mut rows: u32 = 0;
+    let mut step_stack: u32 = 0;
+    let mut emit_stack: u32 = 0;
     for k in 0..steps {
         let mut m = Measurements::default();
-        let s = t_step.measure(&mut cl, |cl| {
-            cl.step_with(|seen| {
-                m = seen;
-                seen
+        let mut step = || {
+            t_step.measure(&mut *cl, |cl| {
+                cl.step_with(|seen| {
+                    m = seen;
+                    seen
+                })
             })
-        });
+        };
+        // The bracket paints before and scans after the instruction count's own bracket.
+        let s = if k % STACK_BRACKET_EVERY == 0 {
+            let (s, depth) = stack::depth(step);
+            step_stack = step_stack.max(depth);
+            s
+        } else {
+            step()
+        };
         if k % every == 0 {
-            s.telemetry.emit();
+            if rows < STACK_BRACKET_FRAMES {
+                let ((), depth) = stack::depth(|| s.telemetry.emit());
+                emit_stack = emit_stack.max(depth);
+            } else {
+                s.telemetry.emit();
+            }
             rows += 1;
         }
         let tel = s.telemetry;
         t_empty.measure((), |()| ());
         // The current-loop step as the controller runs it in Speed and Pressure: the
         // torque feed-forward looked up and added to the q reference, then the step.
-        t_current.measure((&mut current, &compensation), |(c, ff)| {
+        t_current.measure((&mut current, compensation), |(c, ff)| {
             let (iq_ff, flux) =
                 ff.current(tel.theta_m_rad, tel.speed_rad_s, tel.p_pa, tel.iq_ref_a);
             c.step(
@@ -129,15 +161,20 @@ fn run() -> Result<(), ()> {
         );
         // The speed-loop step as the controller runs it: the reference modulated against
         // the pump's flow ripple, the acceleration current added.
-        t_speed.measure((&mut speed, &compensation), |(sl, ff)| {
+        t_speed.measure((&mut speed, compensation), |(sl, ff)| {
             let (w_ref, i_acc) = ff.flow().modulate(tel.theta_m_rad, tel.speed_ref_rad_s);
             sl.step(w_ref, tel.speed_rad_s) + i_acc
         });
         t_pressure.measure(&mut pressure, |pl| pl.step(tel.p_pa));
     }
 
+    let Some(paths) = firmware_paths::measure(&config, &Table::ZERO) else {
+        defmt::error!("PIL: the firmware's boot or save path failed on the RAM flash");
+        return Err(());
+    };
+    let run_stack = stack::whole_run();
     defmt::info!(
-        "PIL current_loop_instructions={=f64} speed_loop_instructions={=f64} pressure_loop_instructions={=f64} closed_loop_step_instructions={=f64} sin_cos_instructions={=f64} svpwm_instructions={=f64} bracket_overhead_instructions={=f64} instructions_per_tick_measured={=f64} calls={=u64} simulated_s={=f64} telemetry_rows={=u32}",
+        "PIL current_loop_instructions={=f64} speed_loop_instructions={=f64} pressure_loop_instructions={=f64} closed_loop_step_instructions={=f64} sin_cos_instructions={=f64} svpwm_instructions={=f64} bracket_overhead_instructions={=f64} instructions_per_tick_measured={=f64} calls={=u64} simulated_s={=f64} telemetry_rows={=u32} stack_peak_bytes={=u32} stack_size_bytes={=u32} closed_loop_step_stack_bytes={=u32} telemetry_emit_stack_bytes={=u32} boot_stack_bytes={=u32} parameter_save_stack_bytes={=u32} can_serve_stack_bytes={=u32} harness_setup_stack_bytes={=u32}",
         t_current.mean_instructions(&t_empty),
         t_speed.mean_instructions(&t_empty),
         t_pressure.mean_instructions(&t_empty),
@@ -148,16 +185,64 @@ fn run() -> Result<(), ()> {
         per_tick,
         t_current.calls(),
         cl.time_s(),
-        rows
+        rows,
+        run_stack.peak_bytes,
+        run_stack.size_bytes,
+        step_stack,
+        emit_stack,
+        paths.boot,
+        paths.save,
+        paths.serve,
+        setup_stack
     );
     Ok(())
+}
+
+/// The loop and the feed-forward built into static memory, with the stack that took.
+/// [bytes]
+#[inline(never)]
+fn setup(
+    rig: &Rig,
+    config: &firmware::Config,
+    scenario: &closed_loop::Scenario,
+) -> (
+    Result<&'static mut ClosedLoop, closed_loop::BuildError>,
+    Option<&'static Compensation>,
+    u32,
+) {
+    let ((cl, ff), depth) =
+        stack::depth(|| (build_loop(rig, config, scenario), feed_forward(config)));
+    (cl, ff, depth)
+}
+
+static mut LOOP: MaybeUninit<ClosedLoop> = MaybeUninit::uninit();
+static mut FEED_FORWARD: MaybeUninit<Compensation> = MaybeUninit::uninit();
+
+/// The closed loop of the scenario, moved into static memory.
+#[inline(never)]
+fn build_loop(
+    rig: &Rig,
+    config: &firmware::Config,
+    scenario: &closed_loop::Scenario,
+) -> Result<&'static mut ClosedLoop, closed_loop::BuildError> {
+    let cl = ClosedLoop::new(rig, config, scenario, SEED)?;
+    // SAFETY: called once, before any reference to the static exists.
+    Ok(unsafe { (*addr_of_mut!(LOOP)).write(cl) })
+}
+
+/// [`active_feed_forward`], moved into static memory.
+#[inline(never)]
+fn feed_forward(config: &firmware::Config) -> Option<&'static Compensation> {
+    let c = active_feed_forward(config)?;
+    // SAFETY: called once, before any reference to the static exists.
+    Some(unsafe { (*addr_of_mut!(FEED_FORWARD)).write(c) })
 }
 
 /// An active feed-forward for the measurement: every channel non-zero (a 72/rev line in
 /// the constant channel, 18/rev per pressure, 24/rev per current, a few percent of the
 /// nominal rig's torques), so the step takes its full path; and the speed modulation
 /// against a 9-piston pump's flow ripple, so the speed-loop step does too.
-fn feed_forward(config: &firmware::Config) -> Option<Compensation> {
+fn active_feed_forward(config: &firmware::Config) -> Option<Compensation> {
     let mut cfg = *config;
     cfg.compensation.enabled = true;
     // The speed modulation of a 9-piston pump's kinematic ripple.

@@ -15,8 +15,8 @@
 use crate::dbc::{parameter_signal, DEFAULT_NODE};
 use anyhow::{bail, Context, Result};
 use firmware::can_protocol::{
-    decode_command, decode_reply, encode_command, encode_reply, Frame, Function, NodeId,
-    RejectReason, Rejection, Reply, Request, Status, NO_COMMAND, SETPOINT_RAD_S_PER_LSB,
+    decode_command, decode_reply, encode_command, encode_reply, Diagnostics, Frame, Function,
+    NodeId, RejectReason, Rejection, Reply, Request, Status, NO_COMMAND, SETPOINT_RAD_S_PER_LSB,
     STATUS_RAD_S_PER_LSB,
 };
 use firmware::parameters::ParamId;
@@ -212,6 +212,11 @@ fn expected_reply(r: &Reply) -> Expected {
         Reply::Parameter { id, value } => e
             .coded("ParameterId", id.code(), Some(id.name().into()))
             .float(&parameter_signal(id), value),
+        Reply::Diagnostics(d) => e.int("StackPeak", i64::from(d.stack_peak_bytes), 1.0).int(
+            "StackSize",
+            i64::from(d.stack_size_bytes),
+            1.0,
+        ),
     }
 }
 
@@ -347,6 +352,12 @@ fn samples() -> Vec<Sample> {
             id,
             value: id.default_value(),
         }));
+    }
+    for (peak, size) in [(0, 0), (2_660, 115_072), (u32::MAX, u32::MAX)] {
+        v.push(Sample::Reply(Reply::Diagnostics(Diagnostics {
+            stack_peak_bytes: peak,
+            stack_size_bytes: size,
+        })));
     }
     v
 }

@@ -404,11 +404,18 @@ pub enum ReplyKind {
     Reject,
     /// `Reply::Parameter`.
     Parameter,
+    /// `Reply::Diagnostics`.
+    Diagnostics,
 }
 
 impl ReplyKind {
     /// Every reply kind.
-    pub const ALL: [ReplyKind; 3] = [ReplyKind::Status, ReplyKind::Reject, ReplyKind::Parameter];
+    pub const ALL: [ReplyKind; 4] = [
+        ReplyKind::Status,
+        ReplyKind::Reject,
+        ReplyKind::Parameter,
+        ReplyKind::Diagnostics,
+    ];
 
     /// The kind of a reply (exhaustive: a new reply breaks the build here).
     pub fn of(r: &firmware::can_protocol::Reply) -> ReplyKind {
@@ -417,6 +424,7 @@ impl ReplyKind {
             Reply::Status(_) => ReplyKind::Status,
             Reply::Reject(_) => ReplyKind::Reject,
             Reply::Parameter { .. } => ReplyKind::Parameter,
+            Reply::Diagnostics(_) => ReplyKind::Diagnostics,
         }
     }
 }
@@ -513,6 +521,19 @@ fn reply(kind: ReplyKind) -> Message {
             "Parameter",
             "a live parameter's value in use (answer to SetParameter and GetParameter)",
             parameter_values(),
+        ),
+        ReplyKind::Diagnostics => (
+            id::DIAGNOSTICS,
+            "Diagnostics",
+            "the drive's measurements of itself, once a second",
+            vec![
+                signal("StackPeak", 0, 32, Kind::Unsigned)
+                    .unit("B")
+                    .about("stack high-water mark since power-up"),
+                signal("StackSize", 4, 32, Kind::Unsigned)
+                    .unit("B")
+                    .about("the stack's size: the RAM below the static data"),
+            ],
         ),
     };
     Message {

@@ -2,8 +2,8 @@
 //! machine too:
 //!
 //! 1. what it needs installed when missing ([`setup`]): the `thumbv7em-none-eabihf` target
-//!    (rustup), `qemu-system-arm` and `tmux` (apt-get), Python's `cantools`, `dask` and
-//!    `distributed` (a virtual environment);
+//!    (rustup), the `flip-link` linker (cargo install), `qemu-system-arm` and `tmux`
+//!    (apt-get), Python's `cantools`, `dask` and `distributed` (a virtual environment);
 //! 2. `cargo fmt --check` and `cargo clippy --workspace --all-targets -D warnings`;
 //! 3. the host tests of the whole workspace, and `eha fleet` against its Dask driver on a
 //!    local two-worker cluster and against its shards ([`fleet_check`]);
@@ -14,7 +14,8 @@
 //!    parameter pages), written to `target/firmware-size.json`;
 //! 6. the processor-in-the-loop run in QEMU ([`pil`]): the control core and the plant on
 //!    the Cortex-M4F, telemetry through defmt and `eha ingest`, compared with the host run,
-//!    instruction counts against `pil/budget.toml`, figures in `target/pil/report.json`;
+//!    instruction counts against `pil/budget.toml`, the stack's high-water mark against the
+//!    firmware's stack (at least 4×), figures in `target/pil/report.json`;
 //!    the same telemetry piped into `eha watch` under tmux ([`watch_check`]): its screen
 //!    checked, its bench log equal to `eha ingest`'s.
 //!
@@ -38,6 +39,9 @@ const TARGET: &str = "thumbv7em-none-eabihf";
 /// 96 KiB: an STM32G431xB (128 KiB) still holds the image and the parameter store's pages.
 const FLASH_BUDGET: u64 = 96 * 1024;
 const RAM_BUDGET: u64 = 16 * 1024;
+/// The STM32G474RE's RAM as `memory.x` describes it. With flip-link the stack has all of
+/// it below the statics: at least this less [`RAM_BUDGET`].
+const FIRMWARE_RAM: u64 = 128 * 1024;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -94,7 +98,9 @@ fn run(step: &str, cmd: &mut Command) -> Result<()> {
     Ok(())
 }
 
+/// The Cortex-M4F target and the linker its images use (flip-link).
 fn ensure_target() -> Result<()> {
+    setup::linker()?;
     let out = Command::new("rustup")
         .args(["target", "list", "--installed"])
         .output()

@@ -4,7 +4,8 @@
 //! log by `eha ingest`, and piped into `eha watch` in tmux (`watch_check`); the same
 //! scenario run on the host by `eha simulate` and the two logs compared sample by sample;
 //! the figures written to `target/pil/report.json`; the current-loop step's instruction
-//! count checked against `pil/budget.toml`.
+//! count checked against `pil/budget.toml`; the stack's high-water mark of the run checked
+//! against the firmware's stack: at least [`STACK_MARGIN_MIN`] times over.
 
 use anyhow::{bail, Context, Result};
 use defmt_decoder::{DecodeError, Table};
@@ -22,6 +23,8 @@ const DURATION_S: &str = "0.5";
 const SEED: &str = "1";
 /// What the regression guard allows above the recorded current-loop budget. [%]
 const BUDGET_TOLERANCE_PERCENT: f64 = 10.0;
+/// How many times the PIL's stack high-water mark must fit in the firmware's stack.
+const STACK_MARGIN_MIN: f64 = 4.0;
 /// Signals compared between the PIL and the host run.
 const COMPARED: [&str; 4] = ["p_pa", "speed_rad_s", "iq_a", "id_a"];
 
@@ -111,6 +114,12 @@ pub fn pil() -> Result<()> {
 
     let current = figure(&figures, "current_loop_instructions")?;
     let (budget, goal) = budget()?;
+    let stack_peak = figure(&figures, "stack_peak_bytes")?;
+    // The check holds the run to the stack the budget guarantees the firmware (its RAM
+    // less the static-RAM budget); the image's own figure is reported beside it.
+    let firmware_stack_min = (crate::FIRMWARE_RAM - crate::RAM_BUDGET) as f64;
+    let firmware_stack = firmware_stack_bytes();
+    let stack_margin = firmware_stack_min / stack_peak.max(1.0);
     let report = serde_json::json!({
         "current_loop_instructions": current,
         "speed_loop_instructions": figure(&figures, "speed_loop_instructions")?,
@@ -129,6 +138,20 @@ pub fn pil() -> Result<()> {
         "current_loop_budget_instructions": budget,
         "current_loop_goal_instructions": goal,
         "qemu_wall_s": wall_s,
+        "stack": {
+            "pil_peak_bytes": stack_peak,
+            "pil_region_bytes": figure(&figures, "stack_size_bytes")?,
+            "closed_loop_step_bytes": figure(&figures, "closed_loop_step_stack_bytes")?,
+            "telemetry_emit_bytes": figure(&figures, "telemetry_emit_stack_bytes")?,
+            "firmware_boot_bytes": figure(&figures, "boot_stack_bytes")?,
+            "parameter_save_bytes": figure(&figures, "parameter_save_stack_bytes")?,
+            "can_serve_bytes": figure(&figures, "can_serve_stack_bytes")?,
+            "harness_setup_bytes": figure(&figures, "harness_setup_stack_bytes")?,
+            "firmware_stack_min_bytes": firmware_stack_min,
+            "firmware_stack_bytes": firmware_stack,
+            "margin": stack_margin,
+            "margin_min": STACK_MARGIN_MIN,
+        },
     });
     let report_path = out_dir.join("report.json");
     fs::write(&report_path, format!("{report:#}\n"))?;
@@ -145,6 +168,13 @@ pub fn pil() -> Result<()> {
              target/pil/pil.csv and host.csv)"
         );
     }
+    if stack_margin < STACK_MARGIN_MIN {
+        bail!(
+            "the PIL run's stack reached {stack_peak:.0} bytes: the firmware's stack of at \
+             least {firmware_stack_min:.0} bytes holds it only {stack_margin:.1} times, below \
+             {STACK_MARGIN_MIN}"
+        );
+    }
     if current > goal {
         bail!(
             "the current-loop step takes {current:.0} instructions, above its ceiling of \
@@ -159,6 +189,24 @@ pub fn pil() -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The firmware image's stack region (`_stack_start − _stack_end`, as flip-link placed
+/// it), when the image has been built. [bytes]
+fn firmware_stack_bytes() -> Option<u64> {
+    use object::{Object, ObjectSymbol};
+    let elf = crate::target_dir()
+        .join(crate::TARGET)
+        .join("release")
+        .join("firmware");
+    let data = fs::read(elf).ok()?;
+    let file = object::File::parse(&*data).ok()?;
+    let symbol = |name: &str| {
+        file.symbols()
+            .find(|s| s.name() == Ok(name))
+            .map(|s| s.address())
+    };
+    symbol("_stack_start")?.checked_sub(symbol("_stack_end")?)
 }
 
 /// `eha` from the workspace (the host tests have already built it).

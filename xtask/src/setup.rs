@@ -1,6 +1,8 @@
 //! What `cargo xtask test` needs beyond Rust, installed when missing so the README's one
 //! command works on a fresh machine (Debian or Ubuntu, as root or with sudo-less apt):
 //!
+//! - `flip-link`, the linker of the Cortex-M images (`.cargo/config.toml`), with
+//!   `cargo install --locked` at the version [`FLIP_LINK_VERSION`];
 //! - `qemu-system-arm` (QEMU's Cortex-M4F, `mps2-an386`) for the processor-in-the-loop run;
 //! - `tmux`, the terminal `eha watch`'s screen test runs the live view in;
 //! - Python's `cantools`, `dask` and `distributed` (pinned in `xtask/requirements.txt`) in a
@@ -46,6 +48,32 @@ fn apt_install(packages: &[&str]) -> Result<()> {
             .args(["install", "-y", "--no-install-recommends"])
             .args(packages),
     )
+}
+
+/// The flip-link release the images are linked with.
+pub const FLIP_LINK_VERSION: &str = "0.1.12";
+
+/// Installs flip-link with cargo when it is missing (it prints its usage and exits 0 when
+/// run without arguments).
+pub fn linker() -> Result<()> {
+    let installed = Command::new("flip-link")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !installed {
+        crate::run(
+            "install flip-link (the Cortex-M images' linker)",
+            Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())).args([
+                "install",
+                "flip-link",
+                "--locked",
+                "--version",
+                FLIP_LINK_VERSION,
+            ]),
+        )?;
+    }
+    Ok(())
 }
 
 /// Installs the tools of [`TOOLS`] that are missing.

@@ -7,14 +7,16 @@
 //! `Parameter` frame for a parameter get or set, a reject naming the bound for a refused
 //! or malformed one). `SaveParameters` writes the flash from this task
 //! ([`super::param_flash::save`]), outside the controller's critical section. The transmit task
-//! sends queued replies and, when none is due, a status every [`STATUS_PERIOD`]. The
+//! sends queued replies and, when none is due, a status every [`STATUS_PERIOD`], and every
+//! [`DIAGNOSTICS_EVERY`]-th of those a `Diagnostics` frame (the stack's high-water mark,
+//! [`super::supervision::stack_use`]). The
 //! command timeout itself is the controller's: heartbeats are forwarded to it like any
 //! other command.
 //!
 //! The FDCAN's acceptance filter passes only this node's command frames
 //! ([`firmware::can_protocol::acceptance_filters`], set in [`super::board`]), and its
 //! interrupt moves them from the three-deep hardware FIFO into a queue of [`RX_QUEUE`]
-//! frames, so a burst that arrives while a parameter save blocks the tasks for ~22 ms is
+//! frames, so a burst that arrives while a parameter save blocks the tasks for ~50 ms is
 //! kept, not overwritten.
 
 use embassy_stm32::can::{
@@ -25,14 +27,15 @@ use embassy_sync::channel::Channel;
 use embassy_time::{with_timeout, Duration};
 use embedded_can::Id;
 use firmware::can_protocol::{
-    decode_command, encode_reply, Frame, Function, NodeId, Rejection, Reply, Request, Status,
-    NO_COMMAND,
+    decode_command, encode_reply, Diagnostics, Frame, Function, NodeId, Rejection, Reply, Request,
+    Status, NO_COMMAND,
 };
 use firmware::can_server::{save_failed, serve, Response};
 use firmware::Mode;
 
 use super::control;
 use super::param_flash::{self, Store};
+use super::supervision;
 
 /// Period of the unsolicited status frame.
 pub const STATUS_PERIOD: Duration = Duration::from_millis(100);
@@ -40,6 +43,8 @@ pub const STATUS_PERIOD: Duration = Duration::from_millis(100);
 pub const RX_QUEUE: usize = 16;
 /// Frames held between the transmit task and the CAN interrupt.
 pub const TX_QUEUE: usize = 4;
+/// Unsolicited statuses per `Diagnostics` frame (one a second).
+pub const DIAGNOSTICS_EVERY: u32 = 10;
 
 /// The started CAN peripheral with its queues, as the receive task reads it.
 pub type Link = BufferedCan<'static, TX_QUEUE, RX_QUEUE>;
@@ -96,28 +101,44 @@ pub async fn receive(mut link: Link, node: NodeId, mut store: Option<Store>) {
     }
 }
 
-/// Sends replies and the periodic status.
+/// Sends replies, the periodic status and the diagnostics.
 #[embassy_executor::task]
 pub async fn transmit(mut tx: BufferedCanSender, node: NodeId) {
     let mut sequence: u8 = 0;
     let mut last_command = NO_COMMAND;
+    let mut periodic: u32 = 0;
     loop {
-        let reply = match with_timeout(STATUS_PERIOD, OUTGOING.receive()).await {
-            Ok(Outgoing::Reply(r)) => r,
+        let (reply, unsolicited) = match with_timeout(STATUS_PERIOD, OUTGOING.receive()).await {
+            Ok(Outgoing::Reply(r)) => (r, false),
             Ok(Outgoing::Ack(function)) => {
                 last_command = function;
-                status(last_command, sequence)
+                (status(last_command, sequence), false)
             }
-            Err(_timeout) => status(last_command, sequence),
+            Err(_timeout) => (status(last_command, sequence), true),
         };
         if matches!(reply, Reply::Status(_)) {
             sequence = sequence.wrapping_add(1);
         }
-        let frame = encode_reply(&reply, node);
-        if let Ok(hal) = HalFrame::new_standard(frame.id(), frame.payload()) {
-            // Waits for room in the queue the CAN interrupt drains.
-            tx.write(hal).await;
+        send(&mut tx, &reply, node).await;
+        if unsolicited {
+            periodic = periodic.wrapping_add(1);
+            if periodic % DIAGNOSTICS_EVERY == 0 {
+                let stack = supervision::stack_use();
+                let diagnostics = Diagnostics {
+                    stack_peak_bytes: stack.peak_bytes,
+                    stack_size_bytes: stack.size_bytes,
+                };
+                send(&mut tx, &Reply::Diagnostics(diagnostics), node).await;
+            }
         }
+    }
+}
+
+/// Queues one reply for the CAN interrupt, waiting for room.
+async fn send(tx: &mut BufferedCanSender, reply: &Reply, node: NodeId) {
+    let frame = encode_reply(reply, node);
+    if let Ok(hal) = HalFrame::new_standard(frame.id(), frame.payload()) {
+        tx.write(hal).await;
     }
 }
 
@@ -126,7 +147,7 @@ fn execute(request: &Request, store: &mut Option<Store>) -> Option<Outgoing> {
         Response::Silent => None,
         Response::Ack(function) => Some(Outgoing::Ack(function)),
         Response::Reply(reply) => Some(Outgoing::Reply(reply)),
-        // `serve` checked that the bridge is off; the erase blocks the tasks ~22 ms.
+        // `serve` checked that the bridge is off; the two erases block the tasks ~50 ms.
         Response::Save(values) => {
             let Some(store) = store.as_mut() else {
                 defmt::error!("parameters: no parameter store (fault 18), not saved");

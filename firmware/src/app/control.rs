@@ -11,8 +11,10 @@
 //! the loop missed a sample; the controller latches its watchdog fault and the bridge is
 //! turned off at once. Liveness for the independent watchdog is the interrupt counter
 //! [`isr_count`], read by the supervision task. A hardware break (gate-driver fault line,
-//! phase comparator, or a break forced by [`super::safe_state`]) latches fault 17; which
-//! sources were active is kept for the supervision task's log ([`last_break_sources`]).
+//! phase comparator, system break, or a break forced by [`super::safe_state`]) latches
+//! fault 17; its sources, latched by the board even when they have gone again
+//! ([`board::break_sources`]), are kept for the supervision task's log
+//! ([`last_break_sources`]).
 //!
 //! Telemetry is captured here, every `telemetry_decimation` periods exactly: the frame
 //! goes into a queue of [`TELEMETRY_QUEUE`] frames without waiting (dropped and counted
@@ -30,6 +32,7 @@ use firmware::{Controller, TelemetryFrame};
 
 use super::board::{self, CURRENT_ADC_REGS};
 use super::bridge::{Bridge, BridgeEvent};
+use super::safe_state;
 use super::sensors::Sensors;
 
 /// Frames the telemetry queue holds: 1.6 ms at full rate (20 kHz), more than the
@@ -44,6 +47,8 @@ pub struct Drive {
     sensors: Sensors,
     /// Periods until the next telemetry frame.
     telemetry_countdown: u32,
+    /// Non-maskable interrupts counted when the last break was seen.
+    nmis_seen: u32,
 }
 
 /// The drive once installed. An explicit zero tag for "empty" (not `Option`, whose `None`
@@ -77,13 +82,16 @@ static TELEMETRY: Channel<CriticalSectionRawMutex, TelemetryFrame, TELEMETRY_QUE
 
 /// Installs the drive; the interrupt does nothing before this.
 pub fn install(controller: Controller, bridge: Bridge, sensors: Sensors) {
+    // Assigned in place, not `replace`d: no second 7.6 KiB value (the old slot) passes over
+    // the stack at boot.
     DRIVE.lock(|d| {
-        d.replace(Slot::Installed(Drive {
+        *d.borrow_mut() = Slot::Installed(Drive {
             controller,
             bridge,
             sensors,
             telemetry_countdown: 1,
-        }))
+            nmis_seen: safe_state::nmis(),
+        })
     });
 }
 
@@ -151,12 +159,23 @@ impl Drive {
     fn step(&mut self) {
         let m = self.sensors.sample();
         let out = self.controller.on_current_sample(&m);
+        let was_on = self.bridge.enabled();
         if self.bridge.apply(&out) == BridgeEvent::Break {
             // The hardware has already cut the bridge; the controller latches it, so
             // restarting takes the operator's clear.
-            BREAK_SOURCES.store(u32::from(board::break_sources()), Ordering::Relaxed);
+            let system = self.bridge.take_system_break();
+            let nmis = safe_state::nmis();
+            let nmi = nmis != self.nmis_seen;
+            self.nmis_seen = nmis;
+            let sources = board::break_sources(system, nmi);
+            board::clear_break_latches();
+            BREAK_SOURCES.store(u32::from(sources), Ordering::Relaxed);
             BREAKS.fetch_add(1, Ordering::Relaxed);
             self.controller.report_hardware_break();
+        } else if !was_on && self.bridge.enabled() {
+            // A fresh enable: what the latches caught meanwhile (a comparator pulse shorter
+            // than the break filter) belongs to no break.
+            board::clear_break_latches();
         }
         self.telemetry_countdown = self.telemetry_countdown.saturating_sub(1);
         if self.telemetry_countdown == 0 {

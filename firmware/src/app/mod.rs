@@ -6,15 +6,19 @@
 //!   current loop.
 //! - [`control`]: the current-loop interrupt (highest priority, not a task) and the state
 //!   it shares with the tasks; [`bridge`] and [`sensors`] are its drivers.
-//! - [`safe_state`]: the bridge off on a panic, a HardFault, a debug halt or a stall.
+//! - [`safe_state`]: the bridge off on a panic, a HardFault, an NMI (a flash ECC error), a
+//!   core lockup, a debug halt or a stall.
 //! - [`param_flash`]: the parameter table at the end of flash bank 2.
 //! - Tasks on the thread-mode executor: [`can_link`] (commands and replies over FDCAN1),
-//!   [`telemetry`] (defmt over RTT), [`supervision`] (independent watchdog, LED, load).
+//!   [`telemetry`] (defmt over RTT), [`supervision`] (independent watchdog, LED, load,
+//!   stack high-water mark).
 //!
 //! Start-up: configuration validated (on error the bridge stays off and the error is
 //! logged), peripherals brought up with the bridge disabled, the stored parameter table
 //! applied over the defaults ([`firmware::param_store::boot`]: a corrupt, other-version
-//! or inconsistent record gives the defaults and latches fault 16; a flash without the
+//! or inconsistent record gives the defaults and latches fault 16 — a copy with a double
+//! word torn by a power loss during a save raises an ECC error whose NMI the board
+//! handles, and is refused like a corrupt one, [`param_flash`]; a flash without the
 //! dual-bank layout gives the defaults and fault 18), the stored torque feed-forward table
 //! loaded (a wrong size, version, CRC or amplitude refuses it alone: fault 21, the drive
 //! runs uncompensated), a watchdog reset of the previous run
@@ -44,6 +48,7 @@ use firmware::{Config, Controller};
 
 use bridge::Bridge;
 use param_flash::Store;
+use safe_state::{ecc_errors, last_ecc_error};
 use sensors::Sensors;
 
 #[embassy_executor::main]
@@ -78,8 +83,10 @@ async fn main(spawner: Spawner) {
     let b = board::init(pwm_hz, &config, node);
     let t = b.timing;
     defmt::info!(
-        "power stage: TIM1 at {=u32} Hz, dead time {=u32} ns, break filter {=u32} ns, over-current trip at {=f32} A (DAC3 code {=u16})",
+        "power stage: TIM1 at {=u32} Hz, ARR {=u16} ({=f32} Hz PWM), dead time {=u32} ns, break filter {=u32} ns, over-current trip at {=f32} A (DAC3 code {=u16})",
         t.timer_hz,
+        t.arr,
+        t.pwm_hz,
         t.dead_time_ns,
         t.break_filter_ns,
         config.limits.hardware_over_current_a,
@@ -129,6 +136,7 @@ fn load_parameters(
         controller.report_parameter_flash_layout();
         return None;
     };
+    let ecc_before = ecc_errors();
     match boot(&mut store, |v| controller.load_parameters(v).is_ok()) {
         BootOutcome::Stored { sequence } => {
             defmt::info!("parameters: stored table {} loaded", sequence);
@@ -162,6 +170,14 @@ fn load_parameters(
             defmt::error!("parameters: stored table unusable, defaults loaded (fault 16)");
             controller.report_parameter_store_invalid();
         }
+    }
+    let ecc = ecc_errors().wrapping_sub(ecc_before);
+    if ecc != 0 {
+        defmt::error!(
+            "parameters: {=u32} uncorrectable flash ECC errors reading the stored pages (a save cut by a power loss), the copy concerned refused; FLASH_ECCR {=u32:#x}",
+            ecc,
+            last_ecc_error()
+        );
     }
     Some(store)
 }

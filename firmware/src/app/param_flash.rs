@@ -17,29 +17,44 @@
 //!
 //! Erasing or programming bank 2 does not stall instruction fetches from bank 1 (the G4
 //! reads one bank while it writes the other), so the current-loop interrupt keeps running
-//! through a save. The CAN task that saves is blocked for the erase (about 22 ms,
-//! datasheet at most 24.5 ms) and so is the rest of the thread-mode executor — the
-//! supervision task included. Around the flash operations this module therefore
-//!
-//! - stretches the independent watchdog's reload to its longest (about 0.5 s) and restores
-//!   it after: the 20 ms timeout is shorter than one erase;
-//! - counts a maintenance window ([`maintenance_windows`]), so the supervision task does
-//!   not take its own late checks for a stalled loop.
+//! through a save. The CAN task that saves is blocked for the erase of the slot's two pages
+//! (about 22 ms each, datasheet at most 24.5 ms) and the programming, about 50 ms in all,
+//! and so is the rest of the thread-mode executor — the supervision task included. Around
+//! the flash operations this module therefore stretches the independent watchdog's reload
+//! to its longest (about 0.5 s) and restores it after: the 20 ms timeout is shorter than
+//! one erase. The supervision task needs nothing: it judges the loop by the time that has
+//! actually elapsed between its checks ([`firmware::liveness`]), so its first check after
+//! the save sees 50 ms of interrupts and the ones its timer fires late, back to back, are
+//! too close together to be judged.
 //!
 //! Saving is still allowed in Disabled only ([`firmware::can_server::serve`]): the
 //! command timeout and the CAN replies wait for the erase.
-
-use core::sync::atomic::{AtomicU32, Ordering};
+//!
+//! # A save cut by a power loss
+//!
+//! The store's A/B slots and commit word keep the previous table through a cut at any
+//! point ([`firmware::param_store`]). A double word whose programming was cut can hold
+//! data and ECC bits that disagree: reading it at the next boot raises an uncorrectable
+//! ECC error, an NMI, which [`super::safe_state`] counts and clears. The store reads
+//! through [`EccChecked`], so such a read fails and that copy is refused like a corrupt
+//! one (its CRC would refuse it too): the other copy loads, or the defaults with fault 16.
 
 use embassy_stm32::flash::{Blocking, Flash, FLASH_SIZE, MAX_ERASE_SIZE};
 use embassy_stm32::pac;
 use embassy_stm32::pac::iwdg::vals::Key;
 use firmware::compensation::record::Encoder;
+use firmware::param_store::ecc::{CheckedError, EccChecked};
 use firmware::param_store::{ParamStore, StoreError, SPAN};
 use firmware::parameters::COUNT;
 
+use super::safe_state;
+
+/// The G474 flash, its reads checked for uncorrectable ECC errors.
+pub type CheckedFlash = EccChecked<Flash<'static, Blocking>, fn() -> u32>;
 /// The store on the G474 flash.
-pub type Store = ParamStore<Flash<'static, Blocking>>;
+pub type Store = ParamStore<CheckedFlash>;
+/// Why a store operation failed.
+pub type Error = StoreError<CheckedError<embassy_stm32::flash::Error>>;
 
 /// Erase page of bank 2 in dual-bank mode. [bytes]
 pub const PAGE_BYTES: u32 = MAX_ERASE_SIZE as u32;
@@ -65,30 +80,17 @@ const _: () = assert!(
 /// Longest IWDG reload value (12-bit counter).
 const IWDG_RELOAD_MAX: u16 = 0x0FFF;
 
-static MAINTENANCE: AtomicU32 = AtomicU32::new(0);
-
-/// Number of flash maintenance windows so far (wraps); the supervision task skips its
-/// liveness verdict when this moved.
-pub fn maintenance_windows() -> u32 {
-    MAINTENANCE.load(Ordering::Relaxed)
-}
-
 /// Opens the store on its two slots.
-pub fn open(
-    flash: Flash<'static, Blocking>,
-) -> Result<Store, StoreError<embassy_stm32::flash::Error>> {
-    ParamStore::new(flash, SLOT_A, SLOT_B, SLOT_BYTES)
+pub fn open(flash: Flash<'static, Blocking>) -> Result<Store, Error> {
+    let checked: CheckedFlash = EccChecked::new(flash, safe_state::ecc_errors);
+    ParamStore::new(checked, SLOT_A, SLOT_B, SLOT_BYTES)
 }
 
 /// Saves `values` and the controller's torque feed-forward table with the watchdog
 /// stretched; returns the record's sequence number. Call only with the bridge disabled.
 /// The table's record is copied out of the controller 48 bytes at a time, each copy a
 /// short critical section, never across a flash operation.
-pub fn save(
-    store: &mut Store,
-    values: &[f32; COUNT],
-) -> Result<u32, StoreError<embassy_stm32::flash::Error>> {
-    MAINTENANCE.fetch_add(1, Ordering::Relaxed);
+pub fn save(store: &mut Store, values: &[f32; COUNT]) -> Result<u32, Error> {
     let reload = set_watchdog_reload(IWDG_RELOAD_MAX);
     let mut encoder = Encoder::new();
     let result = store.save(values, |buf| {
@@ -101,7 +103,6 @@ pub fn save(
         .flatten()
     });
     set_watchdog_reload(reload);
-    MAINTENANCE.fetch_add(1, Ordering::Relaxed);
     result
 }
 

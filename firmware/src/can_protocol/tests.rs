@@ -190,6 +190,21 @@ fn reject_layout_and_round_trip() {
 }
 
 #[test]
+fn diagnostics_layout_and_round_trip() {
+    let d = Diagnostics {
+        stack_peak_bytes: 0x0000_0A64,
+        stack_size_bytes: 0x0001_C180,
+    };
+    let f = encode_reply(&Reply::Diagnostics(d), node(3));
+    assert_eq!(f.id(), 0x1B3);
+    // u32 little endian: 2660 bytes of 115 072.
+    assert_eq!(f.payload(), &[0x64, 0x0A, 0, 0, 0x80, 0xC1, 0x01, 0]);
+    assert_eq!(decode_reply(&f, node(3)), Ok(Reply::Diagnostics(d)));
+    // Not a command: another node's diagnostics or this node's are never served.
+    assert!(decode_command(&f, node(3)).is_err());
+}
+
+#[test]
 fn malformed_replies_are_rejected() {
     let me = node(1);
     assert!(matches!(

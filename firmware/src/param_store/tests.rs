@@ -10,14 +10,16 @@ use super::*;
 use crate::compensation::{record as comp_record, Table, BINS, CHANNELS};
 use crate::parameters::ParamId;
 use embedded_storage::nor_flash::{ErrorType, NorFlashError, NorFlashErrorKind, ReadNorFlash};
+use std::cell::Cell;
+use std::rc::Rc;
 use std::vec::Vec;
 
 /// G474 dual-bank erase page and programming unit.
-const PAGE: usize = 2048;
-const WORD: usize = 8;
+pub(super) const PAGE: usize = 2048;
+pub(super) const WORD: usize = 8;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum FlashError {
+pub(super) enum FlashError {
     PowerCut,
     NotErased,
     Unaligned,
@@ -37,20 +39,22 @@ impl NorFlashError for FlashError {
 /// NOR flash in RAM with the G4's rules (erase to 0xFF by page, program whole erased
 /// double words only) and a power budget in byte operations: the byte at which the
 /// budget runs out is left half-done (an interrupted erase or program leaves bits that are
-/// neither old nor new), and every later operation fails.
-struct CutFlash {
-    mem: Vec<u8>,
+/// neither old nor new), and every later operation fails. Double words marked torn
+/// ([`CutFlash::torn`]) read back as they are and raise an uncorrectable ECC error, which
+/// [`CutFlash::ecc_errors`] counts as the board's NMI handler does.
+pub(super) struct CutFlash {
+    pub(super) mem: Vec<u8>,
     budget: Option<usize>,
     dead: bool,
+    /// Offsets of the double words whose ECC bits disagree with their data.
+    pub(super) torn: Vec<usize>,
+    /// Uncorrectable ECC errors raised by reads so far.
+    pub(super) ecc_errors: Rc<Cell<u32>>,
 }
 
 impl CutFlash {
-    fn blank(pages: usize) -> CutFlash {
-        CutFlash {
-            mem: vec![0xFF; pages * PAGE],
-            budget: None,
-            dead: false,
-        }
+    pub(super) fn blank(pages: usize) -> CutFlash {
+        CutFlash::reboot(vec![0xFF; pages * PAGE], None)
     }
 
     /// The same memory after a reboot, with `budget` byte operations before power fails.
@@ -59,6 +63,8 @@ impl CutFlash {
             mem,
             budget,
             dead: false,
+            torn: Vec::new(),
+            ecc_errors: Rc::new(Cell::new(0)),
         }
     }
 
@@ -92,6 +98,11 @@ impl ReadNorFlash for CutFlash {
             .get(at..at + bytes.len())
             .ok_or(FlashError::OutOfBounds)?;
         bytes.copy_from_slice(src);
+        for w in &self.torn {
+            if *w < at + bytes.len() && at < *w + WORD {
+                self.ecc_errors.set(self.ecc_errors.get().wrapping_add(1));
+            }
+        }
         Ok(())
     }
 
@@ -120,6 +131,7 @@ impl NorFlash for CutFlash {
             }
             self.mem[i] = 0xFF;
         }
+        self.torn.retain(|w| !(from..to).contains(w));
         Ok(())
     }
 
@@ -147,7 +159,7 @@ impl NorFlash for CutFlash {
 }
 
 /// Erase pages per slot: the record and the feed-forward table need two.
-const SLOT_PAGES: usize = SPAN.div_ceil(PAGE);
+pub(super) const SLOT_PAGES: usize = SPAN.div_ceil(PAGE);
 
 fn store(flash: CutFlash) -> ParamStore<CutFlash> {
     store_in_slots(flash, SLOT_PAGES)
@@ -192,7 +204,7 @@ fn store_in_slots(flash: CutFlash, pages: usize) -> ParamStore<CutFlash> {
 }
 
 /// A table that differs from the defaults in every entry by `k` (valid for small k).
-fn table(k: f32) -> [f32; COUNT] {
+pub(super) fn table(k: f32) -> [f32; COUNT] {
     let mut cfg = Config::nominal();
     ParamId::SpeedKp.set(&mut cfg, 0.14 + 0.01 * k).unwrap();
     ParamId::AbsorberPrechargePa

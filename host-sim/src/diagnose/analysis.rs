@@ -349,7 +349,7 @@ pub fn analyse_reporting(
         d_per_rad: mv[mech::DISPLACEMENT] / (2.0 * std::f64::consts::PI),
     };
     let orders = &rel.orders;
-    let lines = window_lines(log, &facts, orders, shaft.kt, shaft.j, shaft.d_per_rad);
+    let lines = window_lines(log, &facts, rig, orders, shaft.kt, shaft.j, shaft.d_per_rad);
     let (line_id, line_val): (Vec<_>, Vec<_>) = lines
         .iter()
         .partition(|w| w.window.rows.start < facts.split);

@@ -15,20 +15,24 @@
 //! line while a torque effect at the same order (flux harmonics) shows in the torque balance
 //! instead ([`super::angle_locked`]).
 //!
-//! The fit: per steady window the model's line magnitudes |I_d|, |I_q| per unit dead time at
-//! the window's current and speed, the measured ones by weighted least squares (each line's
-//! variance its noise floor plus [`LOOP_TOLERANCE`] of it: the loops are Table 1's, a
-//! bench's differ), the fade band searched over a grid (it is not in the rig contract).
+//! U_6 is read from the currents that flowed ([`crate::diagnose::lines::dead_time_voltage`]):
+//! the current line the dead time causes (0.2 A on a 1 A load) moves the phase currents'
+//! zero crossings and with them the voltage the dead time makes, which the mean current
+//! alone would overstate by half. With the angle logged the phase currents are placed and
+//! the model's lines keep their phases: per steady window the model's complex lines per
+//! unit dead time, the measured ones, by weighted least squares (each line's variance its
+//! noise floor plus [`LOOP_TOLERANCE`] of it: the loops are Table 1's, a bench's differ),
+//! the fade band searched over a grid (it is not in the rig contract). Without the angle
+//! the phases are not placed: the magnitudes at the window's mean current.
 
-use crate::diagnose::back_emf::LOOP_TOLERANCE;
-use crate::diagnose::lines::WindowLines;
+use crate::diagnose::back_emf::{current_tracking, speed_reference_per_angle, LOOP_TOLERANCE};
+use crate::diagnose::lines::{OrderLines, WindowLines};
 use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
 
-/// Dead time the model's lines are computed for (they scale with it). [s]
-pub const REFERENCE_DEAD_TIME_S: f64 = 1e-6;
+pub use crate::diagnose::lines::{DEAD_TIME_BANDS_A as BANDS_A, REFERENCE_DEAD_TIME_S};
 
 /// Longest dead time a line is read as, as a fraction of the PWM period: gate drivers
 /// insert 0.1–3 µs, a few per cent of a 20 kHz period; lines that would need more are not
@@ -36,11 +40,9 @@ pub const REFERENCE_DEAD_TIME_S: f64 = 1e-6;
 /// line divided by a vanishing model line would otherwise read as seconds). [1]
 pub const MAX_DEAD_TIME_PERIODS: f64 = 0.1;
 
-/// Current bands of the dead-time error's fade tried. [A]
-pub const BANDS_A: [f64; 7] = [0.01, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8];
-
-/// The dead time's sixth-harmonic d-q voltage at current (i_d, i_q) for `band`, per
-/// [`REFERENCE_DEAD_TIME_S`]: the plant's inverter over one electrical turn. [V]
+/// The dead time's sixth-harmonic d-q voltage at a constant current (i_d, i_q) for `band`,
+/// per [`REFERENCE_DEAD_TIME_S`]: the plant's inverter over one electrical turn. The
+/// reading without the angle, where the phases' zero crossings are not placed. [V]
 pub fn sixth_harmonic_voltage(rig: &Rig, i_d: f64, i_q: f64, band: f64) -> (Complex64, Complex64) {
     let mut p = rig.inverter.clone();
     p.dead_time_s = REFERENCE_DEAD_TIME_S;
@@ -60,7 +62,8 @@ pub fn sixth_harmonic_voltage(rig: &Rig, i_d: f64, i_q: f64, band: f64) -> (Comp
     (d, q)
 }
 
-/// The current loops' disturbance sensitivity on (d, q) at angular frequency `w`. [A/V]
+/// The current loops' disturbance sensitivity on (d, q) at angular frequency `w` (signed:
+/// a line turning backwards is the conjugate). [A/V]
 pub fn disturbance_sensitivity(rig: &Rig, w: f64) -> (Complex64, Complex64) {
     let c = closed_loop::controller_config(rig).current;
     let m = &rig.motor;
@@ -83,39 +86,57 @@ pub struct DeadTimeFit {
     pub lambda: f64,
     /// Windows used.
     pub windows: usize,
+    /// Whether the lines were compared with their phases (the angle logged).
+    pub coherent: bool,
 }
 
-/// One window's measured and modelled line magnitudes with their noise variances.
+/// One window's measured and modelled d and q lines with their noise variances (per real
+/// component); without the angle, their magnitudes on the real axis.
 struct Obs {
-    measured: [f64; 2],
-    model: [f64; 2],
+    measured: [Complex64; 2],
+    model: [Complex64; 2],
     var: [f64; 2],
     /// The noise floors alone, which weigh the scale's estimate (weights from the measured
     /// lines would bias it). [A²]
     floor: [f64; 2],
 }
 
+/// The index of `band` in [`BANDS_A`].
+fn band_index(band: f64) -> usize {
+    BANDS_A.iter().position(|b| *b == band).unwrap_or(0)
+}
+
 fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]) -> Vec<Obs> {
     let pp = rig.motor.pole_pairs;
     let order = 6 * pp;
+    let b = band_index(band);
     lines
         .iter()
         .filter_map(|w| {
             let o = w.at(order)?;
+            let [y_d, y_q, model_var] = loop_lines(w, o, rig)?;
             let floor_d = w.floor(order, candidates, |x| x.id);
             let floor_q = w.floor(order, candidates, |x| x.iq);
             // The loops' model is Table 1's: its uncertainty on top of the noise floor.
             let tol = |z: Complex64| 0.5 * (LOOP_TOLERANCE * z.norm()).powi(2);
-            let (var_d, var_q) = (floor_d + tol(o.id), floor_q + tol(o.iq));
+            let (var_d, var_q) = (floor_d + tol(y_d), floor_q + tol(y_q) + model_var.re);
             if !(var_d.is_finite() && var_q.is_finite()) {
                 return None;
             }
-            let (ed, eq) = sixth_harmonic_voltage(rig, 0.0, w.iq_mean_a, band);
-            let w6 = 6.0 * pp as f64 * w.window.speed_rad_s.abs();
+            let w6 = o.order as f64 * w.window.speed_rad_s;
             let (hd, hq) = disturbance_sensitivity(rig, w6);
+            let (measured, model) = match o.dead_time_voltages.get(b) {
+                // The voltage the logged currents make, phase and all.
+                Some([ed, eq]) => ([y_d, y_q], [hd * ed, hq * eq]),
+                None => {
+                    let (ed, eq) = sixth_harmonic_voltage(rig, 0.0, w.iq_mean_a, band);
+                    let real = |z: Complex64| Complex64::new(z.norm(), 0.0);
+                    ([real(y_d), real(y_q)], [real(hd * ed), real(hq * eq)])
+                }
+            };
             Some(Obs {
-                measured: [o.id.norm(), o.iq.norm()],
-                model: [(hd * ed).norm(), (hq * eq).norm()],
+                measured,
+                model,
                 var: [var_d, var_q],
                 floor: [floor_d, floor_q],
             })
@@ -123,11 +144,43 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
         .collect()
 }
 
+/// The d and q current lines of window `w` at its order `o` that a disturbance voltage
+/// alone explains through the current loops, and the variance (its real part) the q line's
+/// corrections carry: the d line as measured; of the q line what the shaft's measured
+/// oscillation Θ does not account for, the speed loop's answer to it (its reference
+/// −C_ω·jw·Θ followed by the q loop, [`current_tracking`]) and the current its back-EMF
+/// p_n·ψ_f·jw·Θ drives through the q loop:
+///
+/// ```text
+///   Y_q = I_q + G_i(jw)·C_ω(jw)·jw·Θ + H_q(jw)·p_n·ψ_f·jw·Θ = H_q(jw)·U_q
+/// ```
+///
+/// `None` for a window without a speed.
+fn loop_lines(w: &WindowLines, o: &OrderLines, rig: &Rig) -> Option<[Complex64; 3]> {
+    let freq = o.order as f64 * w.window.speed_rad_s;
+    if freq == 0.0 {
+        return None;
+    }
+    let jw_theta = Complex64::new(0.0, freq) * o.theta;
+    let (_, hq) = disturbance_sensitivity(rig, freq);
+    let speed_loop = current_tracking(rig, freq) * speed_reference_per_angle(rig, freq) * o.theta;
+    let emf = hq * (rig.motor.pole_pairs as f64 * rig.motor.psi_f_wb) * jw_theta;
+    let tol = |z: Complex64| 0.5 * (LOOP_TOLERANCE * z.norm()).powi(2);
+    Some([
+        o.id,
+        o.iq + speed_loop + emf,
+        Complex64::new(tol(speed_loop) + tol(emf), 0.0),
+    ])
+}
+
 /// Fits the dead time to the d and q current lines at order 6·p_n of `lines`.
 pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> Option<DeadTimeFit> {
     let mut best: Option<(f64, DeadTimeFit)> = None;
     let max_scale =
         MAX_DEAD_TIME_PERIODS / rig.inverter.pwm_frequency_hz.max(1.0) / REFERENCE_DEAD_TIME_S;
+    let coherent = lines
+        .iter()
+        .any(|w| w.orders.iter().any(|o| !o.dead_time_voltages.is_empty()));
     for band in BANDS_A {
         let obs = observations(lines, rig, band, candidates);
         if obs.is_empty() {
@@ -141,12 +194,26 @@ pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> O
             band_a: band,
             lambda,
             windows: obs.len(),
+            coherent,
         };
         if best.as_ref().is_none_or(|(b, _)| by_floor > *b) {
             best = Some((by_floor, fit));
         }
     }
     best.map(|(_, fit)| fit)
+}
+
+/// The line power the model lines at `scale` explain in `obs`, each line weighed by
+/// `weight`. [1]
+fn explained(obs: &[Obs], scale: f64, weight: fn(&Obs, usize) -> f64) -> f64 {
+    obs.iter()
+        .flat_map(|o| {
+            (0..2).map(move |a| {
+                (o.measured[a].norm_sqr() - (o.measured[a] - o.model[a] * scale).norm_sqr())
+                    / weight(o, a)
+            })
+        })
+        .sum::<f64>()
 }
 
 /// The weighted least-squares scale of the model lines onto the measured ones, and the
@@ -157,8 +224,8 @@ fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64, f64)> {
     let (mut num, mut den) = (0.0, 0.0);
     for o in obs {
         for a in 0..2 {
-            num += o.measured[a] * o.model[a] / o.floor[a];
-            den += o.model[a] * o.model[a] / o.floor[a];
+            num += (o.model[a].conj() * o.measured[a]).re / o.floor[a];
+            den += o.model[a].norm_sqr() / o.floor[a];
         }
     }
     if den <= 0.0 {
@@ -168,21 +235,10 @@ fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64, f64)> {
     if scale > max_scale {
         return None;
     }
-    let explained = |weight: fn(&Obs, usize) -> f64| -> f64 {
-        obs.iter()
-            .flat_map(|o| {
-                (0..2).map(move |a| {
-                    (o.measured[a].powi(2) - (o.measured[a] - scale * o.model[a]).powi(2))
-                        / weight(o, a)
-                })
-            })
-            .sum::<f64>()
-            .max(0.0)
-    };
     Some((
         scale,
-        explained(|o, a| o.floor[a]),
-        explained(|o, a| o.var[a]),
+        explained(obs, scale, |o, a| o.floor[a]).max(0.0),
+        explained(obs, scale, |o, a| o.var[a]).max(0.0),
     ))
 }
 
@@ -197,17 +253,11 @@ pub fn dead_time_gain(
     if obs.is_empty() {
         return None;
     }
-    let scale = fit.dead_time_s / REFERENCE_DEAD_TIME_S;
-    Some(
-        obs.iter()
-            .flat_map(|o| {
-                (0..2).map(move |a| {
-                    (o.measured[a].powi(2) - (o.measured[a] - scale * o.model[a]).powi(2))
-                        / o.var[a]
-                })
-            })
-            .sum(),
-    )
+    Some(explained(
+        &obs,
+        fit.dead_time_s / REFERENCE_DEAD_TIME_S,
+        |o, a| o.var[a],
+    ))
 }
 
 #[cfg(test)]
@@ -229,16 +279,17 @@ mod tests {
     fn lines_are_scaled_onto_the_model_and_refused_beyond_the_plausible_dead_time() {
         // Two windows whose d and q lines are 3× the model's: a scale of 3, and all of the
         // line power (9 + 9 + 36 + 36 noise units over unit variances) explained.
+        let c = |x: f64| Complex64::new(x, 0.0);
         let obs = [
             Obs {
-                measured: [3.0, 3.0],
-                model: [1.0, 1.0],
+                measured: [c(3.0), c(3.0)],
+                model: [c(1.0), c(1.0)],
                 var: [1.0, 1.0],
                 floor: [1.0, 1.0],
             },
             Obs {
-                measured: [6.0, 6.0],
-                model: [2.0, 2.0],
+                measured: [c(6.0), c(6.0)],
+                model: [c(2.0), c(2.0)],
                 var: [1.0, 1.0],
                 floor: [1.0, 1.0],
             },

@@ -148,8 +148,7 @@ impl LogFacts {
                 savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
             });
         let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, &p_low_pa, rig);
-        let t_half = t[0] + 0.5 * (t[rows - 1] - t[0]);
-        let split = t.partition_point(|x| *x < t_half).clamp(1, rows - 1);
+        let split = segment_split(t, &theta_rad, period_s, rig);
         let start = t
             .partition_point(|x| *x < t[0] + START_SKIP_S)
             .min(split / 4);
@@ -221,6 +220,65 @@ impl LogFacts {
             start = end;
         }
         out
+    }
+}
+
+/// Farthest the boundary between the identification and the validation segment moves
+/// from the log's middle, as a fraction of its duration. [1]
+pub const SPLIT_REACH: f64 = 0.2;
+
+/// The first row of the validation segment: the log's middle, unless the steady rotation
+/// slow enough to resolve every angle-locked line (the slot order below a third of the
+/// log's rate) sits mostly on one side of it. A staircase or step whose first level is
+/// reached at the speed limit holds all its slow rotation in its second half, and a line
+/// effect could then be neither fitted nor checked: the boundary moves, within
+/// [`SPLIT_REACH`] of the middle, to the end of the slow window that leaves the lesser side
+/// the most such revolutions (at least twice what the middle leaves it).
+fn segment_split(t: &[f64], theta: &[f64], period_s: f64, rig: &Rig) -> usize {
+    let rows = t.len();
+    let at = |f: f64| {
+        let t_f = t[0] + f * (t[rows - 1] - t[0]);
+        t.partition_point(|x| *x < t_f).clamp(1, rows - 1)
+    };
+    let highest = rig
+        .motor
+        .cogging_fundamental_order()
+        .max(6 * rig.motor.pole_pairs) as f64;
+    let limit = 2.0 * PI / period_s / 3.0 / highest;
+    let slow: Vec<SteadyWindow> = steady_windows(t, theta, period_s)
+        .into_iter()
+        .filter(|w| w.speed_rad_s.abs() < limit)
+        .collect();
+    let lesser = |split: usize| {
+        let (mut a, mut b) = (0.0, 0.0);
+        for w in &slow {
+            if w.rows.end <= split {
+                a += w.revolutions;
+            } else if w.rows.start >= split {
+                b += w.revolutions;
+            }
+        }
+        f64::min(a, b)
+    };
+    let middle = at(0.5);
+    let (lo, hi) = (at(0.5 - SPLIT_REACH), at(0.5 + SPLIT_REACH));
+    let (best, score) = slow
+        .iter()
+        .map(|w| w.rows.end)
+        .filter(|s| (lo..=hi).contains(s))
+        .map(|s| (s, lesser(s)))
+        .fold((middle, lesser(middle)), |b, c| {
+            let closer = c.0.abs_diff(middle) < b.0.abs_diff(middle);
+            if c.1 > b.1 || (c.1 == b.1 && closer) {
+                c
+            } else {
+                b
+            }
+        });
+    if score > 2.0 * lesser(middle) && score >= STEADY_MIN_REVOLUTIONS {
+        best
+    } else {
+        middle
     }
 }
 

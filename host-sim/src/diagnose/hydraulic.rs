@@ -148,7 +148,14 @@ impl<'a> HydraulicInputs<'a> {
             x_m: facts.x_smooth_m.as_deref(),
             p_pa: &log.p_pa,
             start_rows: rows_spanning(START_S, facts.period_s, 2),
-            fill_pa: facts.fill_pa,
+            // The check valve opens only where the port is the suction side: a moving
+            // payload's. A blocked cylinder's port stays above the fill, and there the floor
+            // would only bend the windows' start, which is fitted as if linear.
+            fill_pa: if facts.piston_moves {
+                facts.fill_pa
+            } else {
+                f64::NEG_INFINITY
+            },
         }
     }
 }

@@ -19,6 +19,8 @@
 use crate::bench_log::BenchLog;
 use crate::diagnose::facts::{LogFacts, SteadyWindow};
 use nalgebra::{DMatrix, DVector};
+use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
+use plant_model::Rig;
 use rustfft::num_complex::Complex64;
 
 /// Neighbouring orders on each side of a line whose amplitudes measure its noise floor.
@@ -40,7 +42,7 @@ pub struct WindowLines {
 }
 
 /// The lines at one order in one window.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct OrderLines {
     /// Cycles per revolution.
     pub order: u32,
@@ -56,6 +58,9 @@ pub struct OrderLines {
     pub torque: Complex64,
     /// Commanded d and q voltages, when logged. [V]
     pub voltages: Option<[Complex64; 2]>,
+    /// The d and q lines of the dead-time voltage the logged currents make, per fade band
+    /// of [`DEAD_TIME_BANDS_A`] at [`REFERENCE_DEAD_TIME_S`] (empty without the angle). [V]
+    pub dead_time_voltages: Vec<[Complex64; 2]>,
 }
 
 impl WindowLines {
@@ -93,6 +98,51 @@ impl WindowLines {
     }
 }
 
+/// Dead time the dead-time voltage lines are computed for (they scale with it). [s]
+pub const REFERENCE_DEAD_TIME_S: f64 = 1e-6;
+
+/// Current bands of the dead-time error's fade tried (the rig contract does not give it). [A]
+pub const DEAD_TIME_BANDS_A: [f64; 7] = [0.01, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8];
+
+/// The d and q dead-time voltage over `rows` per fade band of [`DEAD_TIME_BANDS_A`], at
+/// [`REFERENCE_DEAD_TIME_S`]: the logged d-q currents turned into phase currents at the
+/// electrical angle p_n·θ, each leg's error −t_d·f_pwm·U_dc·sat(i/band) (the plant's
+/// [`Inverter`]) turned back into d-q. Read from the currents that flowed, not from their
+/// mean: the current line the dead time causes moves the phase currents' zero crossings,
+/// and with them the voltage it makes. The logged DC link is used where present. [V]
+pub fn dead_time_voltage(
+    log: &BenchLog,
+    facts: &LogFacts,
+    rig: &Rig,
+    rows: std::ops::Range<usize>,
+) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let pp = rig.motor.pole_pairs as f64;
+    DEAD_TIME_BANDS_A
+        .iter()
+        .map(|&band| {
+            let mut p = rig.inverter.clone();
+            p.dead_time_s = REFERENCE_DEAD_TIME_S;
+            p.dead_time_current_band_a = band;
+            let mut inv = Inverter::new(&p);
+            let (mut d, mut q) = (
+                Vec::with_capacity(rows.len()),
+                Vec::with_capacity(rows.len()),
+            );
+            for k in rows.clone() {
+                if let Some(u) = log.udc_v.as_deref() {
+                    inv.set_u_dc(u[k]);
+                }
+                let (s, c) = (pp * facts.theta_rad[k]).sin_cos();
+                let i = dq_to_abc(log.id_a[k], log.iq_a[k], s, c);
+                let (ud, uq) = pole_to_dq(&inv.pole_voltages(&[0.0; 3], &i), s, c);
+                d.push(ud);
+                q.push(uq);
+            }
+            (d, q)
+        })
+        .collect()
+}
+
 /// The orders to analyse: each candidate and its neighbours, without order 0 and above the
 /// window's Nyquist order.
 fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
@@ -106,18 +156,25 @@ fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
     v
 }
 
-/// Complex amplitudes of `signals` at `orders` over `rows`, by one least-squares fit of a
-/// mean, a slope and sin/cos of k·θ for every order (the orders are near-orthogonal over
+/// Terms of the polynomial in time fitted beside the lines: a cubic. A window's speed is
+/// steady only within a band (a sine test's shaft accelerates through it), and the angle's
+/// curvature left by a straight line would leak into the lines, most at the high orders
+/// whose torque weighs the angle's line with J·(k·ω̄)².
+const TREND_TERMS: usize = 4;
+
+/// Complex amplitudes of `signals` at `orders` over `rows` (each signal a slice whose first
+/// element is the log's row given beside it), by one least-squares fit of a
+/// cubic in time ([`TREND_TERMS`]) and sin/cos of k·θ for every order (the orders are near-orthogonal over
 /// whole revolutions; fitting them together removes what leaks between them).
 fn lock_in(
     t: &[f64],
     theta: &[f64],
     rows: std::ops::Range<usize>,
     orders: &[u32],
-    signals: &[&[f64]],
+    signals: &[(&[f64], usize)],
 ) -> Option<Vec<Vec<Complex64>>> {
     let n = rows.len();
-    let cols = 2 + 2 * orders.len();
+    let cols = TREND_TERMS + 2 * orders.len();
     if n < 2 * cols {
         return None;
     }
@@ -125,29 +182,36 @@ fn lock_in(
     let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
     let a = DMatrix::from_fn(n, cols, |i, j| {
         let k = rows.start + i;
-        match j {
-            0 => 1.0,
-            1 => (t[k] - t0) / span - 0.5,
-            _ => {
-                let order = orders[(j - 2) / 2] as f64;
-                let x = order * theta[k];
-                if (j - 2) % 2 == 0 {
-                    x.cos()
-                } else {
-                    x.sin()
-                }
-            }
+        if j < TREND_TERMS {
+            // Legendre polynomials of the window's time on [−1, 1]: well conditioned.
+            let x = 2.0 * (t[k] - t0) / span - 1.0;
+            return match j {
+                0 => 1.0,
+                1 => x,
+                2 => 1.5 * x * x - 0.5,
+                _ => 2.5 * x * x * x - 1.5 * x,
+            };
+        }
+        let order = orders[(j - TREND_TERMS) / 2] as f64;
+        let x = order * theta[k];
+        if (j - TREND_TERMS) % 2 == 0 {
+            x.cos()
+        } else {
+            x.sin()
         }
     });
     let svd = a.svd(true, true);
     signals
         .iter()
-        .map(|y| {
-            let b = DVector::from_iterator(n, y[rows.clone()].iter().copied());
+        .map(|(y, offset)| {
+            let b = DVector::from_iterator(
+                n,
+                y[rows.start - offset..rows.end - offset].iter().copied(),
+            );
             let x = svd.solve(&b, 1e-12).ok()?;
             Some(
                 (0..orders.len())
-                    .map(|m| Complex64::new(x[2 + 2 * m], -x[3 + 2 * m]))
+                    .map(|m| Complex64::new(x[TREND_TERMS + 2 * m], -x[TREND_TERMS + 1 + 2 * m]))
                     .collect(),
             )
         })
@@ -159,6 +223,7 @@ fn lock_in(
 pub fn window_lines(
     log: &BenchLog,
     facts: &LogFacts,
+    rig: &Rig,
     candidates: &[u32],
     kt: f64,
     j: f64,
@@ -189,10 +254,22 @@ pub fn window_lines(
                 }
                 v
             };
-            let mut signals: Vec<&[f64]> = vec![&log.iq_a, &log.id_a, &trend, &log.p_pa];
+            let mut signals: Vec<(&[f64], usize)> =
+                vec![(&log.iq_a, 0), (&log.id_a, 0), (&trend, 0), (&log.p_pa, 0)];
             let voltages = log.ud_v.as_deref().zip(log.uq_v.as_deref());
             if let Some((ud, uq)) = voltages {
-                signals.extend([ud, uq]);
+                signals.extend([(ud, 0), (uq, 0)]);
+            }
+            // The inverter's dead-time voltage the logged currents make, per fade band
+            // ([`dead_time_voltage`]): only where the angle places the phases.
+            let dead_time = if facts.angle_logged {
+                dead_time_voltage(log, facts, rig, rows.clone())
+            } else {
+                Vec::new()
+            };
+            let first_dead = signals.len();
+            for (d, q) in &dead_time {
+                signals.extend([(d.as_slice(), rows.start), (q.as_slice(), rows.start)]);
             }
             let z = lock_in(t, theta, rows.clone(), &orders, &signals)?;
             let lines = orders
@@ -209,6 +286,9 @@ pub fn window_lines(
                         p,
                         torque: iq * kt + th * (j * wk * wk) - p * d_per_rad,
                         voltages: voltages.map(|_| [z[4][m], z[5][m]]),
+                        dead_time_voltages: (0..dead_time.len())
+                            .map(|b| [z[first_dead + 2 * b][m], z[first_dead + 2 * b + 1][m]])
+                            .collect(),
                     }
                 })
                 .collect();
@@ -240,7 +320,7 @@ mod tests {
             .zip(&t)
             .map(|(a, t)| 0.3 * (18.0 * a - 0.7).cos() + 2.0 * t)
             .collect();
-        let z = lock_in(&t, &th, 0..n, &[17, 18, 19], &[&y]).unwrap();
+        let z = lock_in(&t, &th, 0..n, &[17, 18, 19], &[(&y, 0)]).unwrap();
         let want = Complex64::from_polar(0.3, -0.7);
         assert!((z[0][1] - want).norm() < 1e-9, "{:?}", z[0][1]);
         assert!(z[0][0].norm() < 1e-9 && z[0][2].norm() < 1e-9);

@@ -111,6 +111,18 @@ pub struct ShaftMotion {
     /// The q current's moving mean ([`MEAN_CURRENT_HALF_WIDTH_S`]), which scales the flux
     /// harmonics' torque line. [A]
     pub iq_mean_a: Vec<f64>,
+    /// How the acceleration was read: what it keeps of a line ([`ShaftMotion::accel_gain`]).
+    pub accel_filter: AccelFilter,
+}
+
+/// The filter the acceleration was read through.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AccelFilter {
+    /// The angle's quadratic Savitzky–Golay second derivative over ±`half` rows `period`
+    /// apart. [rows, s]
+    SavitzkyGolay { half: usize, period: f64 },
+    /// The central difference over ±`half` rows of a speed. [rows, s]
+    Central { half: usize, period: f64 },
 }
 
 /// Central difference of `y` against `t` over ±`h` rows, clipped at the ends.
@@ -169,23 +181,58 @@ impl ShaftMotion {
     /// ([`savgol_second_derivative`]).
     pub fn of(log: &BenchLog, facts: &LogFacts) -> ShaftMotion {
         let h = rows_spanning(RATE_HALF_WIDTH_S, facts.period_s, 1);
-        let (speed, accel) = if facts.angle_logged {
+        let period = facts.period_s;
+        let central = AccelFilter::Central { half: h, period };
+        let (speed, accel, accel_filter) = if facts.angle_logged {
             let speed = central_rate(&log.t_s, &facts.theta_rad, h);
-            let accel = if facts.uniform {
-                let m = rows_spanning(SAVGOL_HALF_WIDTH_S, facts.period_s, 1);
-                savgol_second_derivative(&facts.theta_rad, facts.period_s, m)
+            if facts.uniform {
+                let m = rows_spanning(SAVGOL_HALF_WIDTH_S, period, 1);
+                let accel = savgol_second_derivative(&facts.theta_rad, period, m);
+                (speed, accel, AccelFilter::SavitzkyGolay { half: m, period })
             } else {
-                central_rate(&log.t_s, &speed, h)
-            };
-            (speed, accel)
+                let accel = central_rate(&log.t_s, &speed, h);
+                (speed, accel, central)
+            }
         } else {
             let accel = central_rate(&log.t_s, &log.speed_rad_s, h);
-            (log.speed_rad_s.clone(), accel)
+            (log.speed_rad_s.clone(), accel, central)
         };
         ShaftMotion {
             speed_rad_s: speed,
             accel_rad_s2: accel,
             iq_mean_a: mean_current(&log.iq_a, facts.period_s),
+            accel_filter,
+        }
+    }
+
+    /// The fraction of a shaft oscillation's acceleration at angular frequency `w` that
+    /// [`ShaftMotion::accel_rad_s2`] keeps: the filter's response to cos(w·t) over −w², 1 for
+    /// slow motion, falling towards and past the log's Nyquist rate. A torque line the
+    /// acceleration cannot follow is balanced by an oscillation it does not see: the
+    /// torque balance may only carry the share of the line the acceleration keeps. [1]
+    pub fn accel_gain(&self, w: f64) -> f64 {
+        let w = w.abs();
+        if w == 0.0 {
+            return 1.0;
+        }
+        match self.accel_filter {
+            AccelFilter::SavitzkyGolay { half, period } => {
+                let m = half.max(1) as i64;
+                let mean_j2 = (m * (m + 1)) as f64 / 3.0;
+                let (mut num, mut den) = (0.0, 0.0);
+                for j in -m..=m {
+                    let c = (j * j) as f64 - mean_j2;
+                    num += c * (j as f64 * w * period).cos();
+                    den += c * c;
+                }
+                -2.0 * num / (den * period * period) / (w * w)
+            }
+            AccelFilter::Central { half, period } => {
+                // A central difference of a central difference of the angle.
+                let x = w * half.max(1) as f64 * period;
+                let g = x.sin() / x;
+                g * g
+            }
         }
     }
 }
@@ -242,10 +289,19 @@ impl Mechanics {
             + m.coulomb_nm * (speed / COULOMB_FADE_RAD_S).tanh()
     }
 
-    /// The unexplained torque lines at row `k` (electromagnetic torque `t_em`). [N·m]
+    /// The unexplained torque lines at row `k` (electromagnetic torque `t_em`), each the
+    /// share of it the acceleration's filter keeps at the line's frequency. [N·m]
     #[inline]
-    fn line_torque(&self, log: &BenchLog, facts: &LogFacts, k: usize, t_em: f64) -> f64 {
+    fn line_torque(
+        &self,
+        log: &BenchLog,
+        facts: &LogFacts,
+        motion: &ShaftMotion,
+        k: usize,
+        t_em: f64,
+    ) -> f64 {
         let theta = facts.theta_rad[k];
+        let w = motion.speed_rad_s[k];
         self.params
             .lines
             .iter()
@@ -255,7 +311,8 @@ impl Mechanics {
                     LineScale::Electromagnetic => t_em,
                     LineScale::PressureDifference(f) => f * (log.p_pa[k] - facts.p_low_pa[k]),
                 };
-                x * (l.amplitude * Complex64::from_polar(1.0, l.order as f64 * theta)).re
+                let kept = motion.accel_gain(l.order as f64 * w).clamp(0.0, 1.0);
+                kept * x * (l.amplitude * Complex64::from_polar(1.0, l.order as f64 * theta)).re
             })
             .sum()
     }
@@ -277,7 +334,7 @@ impl Mechanics {
             let (slope, rest) = self.torque_terms(log, facts, k);
             let slope = if slope.abs() > 1e-9 { slope } else { 1e-9 };
             let t_mean = slope * slow[k] + rest;
-            out[k] = (need - rest + self.line_torque(log, facts, k, t_mean)) / slope;
+            out[k] = (need - rest + self.line_torque(log, facts, motion, k, t_mean)) / slope;
         }
     }
 
@@ -301,7 +358,7 @@ impl Mechanics {
                 let (slope, rest) = self.torque_terms(log, facts, k);
                 let t_em = slope * log.iq_a[k] + rest;
                 let drive = t_em
-                    - self.line_torque(log, facts, k, slope * slow[k] + rest)
+                    - self.line_torque(log, facts, motion, k, slope * slow[k] + rest)
                     - self.load_torque(log, facts, k, w);
                 w += (t[k + 1] - t[k]) * drive / j;
                 out[k + 1] = w;
