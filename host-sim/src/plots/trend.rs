@@ -80,10 +80,13 @@ fn draw<DB: DrawingBackend>(
         .map(|q| q.0)
         .chain(p.line.iter().map(|q| q.0))
         .chain(p.crossing.iter().flat_map(|((_, lo, hi), _)| [*lo, *hi]));
+    // The estimates, the band and the limit set the y range; an error bar longer than
+    // that is cut at the frame (a log whose parameter it could not tell apart can have a
+    // standard error of 1e100 and would otherwise flatten every other point).
     let ys = p
         .points
         .iter()
-        .flat_map(|q| [q.1 - q.2, q.1 + q.2])
+        .map(|q| q.1)
         .chain(p.line.iter().flat_map(|q| [q.2, q.3]))
         .chain(p.limit);
     let ((x0, x1), (y0, y1)) = match (bounds(xs), bounds(ys)) {
@@ -132,7 +135,10 @@ fn draw<DB: DrawingBackend>(
     chart
         .draw_series(p.points.iter().map(|q| {
             PathElement::new(
-                vec![(q.0, q.1 - q.2), (q.0, q.1 + q.2)],
+                vec![
+                    (q.0, (q.1 - q.2).clamp(y0, y1)),
+                    (q.0, (q.1 + q.2).clamp(y0, y1)),
+                ],
                 POINTS.stroke_width(1),
             )
         }))
