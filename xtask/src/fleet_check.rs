@@ -1,7 +1,8 @@
 //! `eha fleet` against its distributed forms, on a small fleet `eha simulate` writes (two
 //! drives, three monthly 1 s logs each, and a corrupt copy of one):
 //!
-//! 1. `eha fleet` alone, two jobs;
+//! 1. `eha fleet` alone, two jobs, the logs named by a relative path as a user would (the
+//!    driver hands its workers absolute ones: the tables must not show it);
 //! 2. the Dask driver (`tools/fleet_dask.py`) on a local `dask.distributed` cluster of two
 //!    worker processes: its `fleet.csv`, `fleet.json` and `trends.csv` must be byte for
 //!    byte those of step 1;
@@ -112,7 +113,8 @@ pub fn check(python: &Path) -> Result<()> {
         "eha fleet",
         Command::new(&eha)
             .arg("fleet")
-            .arg(&logs)
+            .current_dir(&base)
+            .arg("logs")
             .arg("--out")
             .arg(&alone)
             .args(["--jobs", "2"]),
@@ -124,7 +126,8 @@ pub fn check(python: &Path) -> Result<()> {
         "the Dask driver on a local cluster of two workers",
         Command::new(python)
             .arg(root.join("tools").join("fleet_dask.py"))
-            .arg(&logs)
+            .current_dir(&base)
+            .arg("logs")
             .arg("--out")
             .arg(&dask)
             .arg("--eha")
@@ -157,7 +160,8 @@ pub fn check(python: &Path) -> Result<()> {
             "eha fleet --shard",
             Command::new(&eha)
                 .arg("fleet")
-                .arg(&logs)
+                .current_dir(&base)
+                .arg("logs")
                 .arg("--out")
                 .arg(&out)
                 .args(["--shard", &format!("{k}/2")]),

@@ -241,6 +241,20 @@ fn diagnose_all(
     })
 }
 
+/// `why`, a kept reason, naming the log as the row does: a refusal is kept by the log's
+/// content and names the path it was diagnosed at (another copy of the log, or the absolute
+/// path a distributed driver gave), so the row's path takes its place.
+fn naming(why: &str, path: &Path) -> String {
+    const LOG: &str = "bench log `";
+    let Some(rest) = why.strip_prefix(LOG) else {
+        return why.to_string();
+    };
+    match rest.find('`') {
+        Some(end) => format!("{LOG}{}{}", path.display(), &rest[end..]),
+        None => why.to_string(),
+    }
+}
+
 /// The table's rows, in the entries' order.
 fn rows(entries: Vec<Entry>, hashes: Vec<Result<String, String>>, r: &Results) -> Vec<Row> {
     entries
@@ -250,11 +264,11 @@ fn rows(entries: Vec<Entry>, hashes: Vec<Result<String, String>>, r: &Results) -
             let (sha256, result) = match h {
                 Err(why) => (None, Err(why)),
                 Ok(h) => {
-                    let result = r
-                        .by_hash
-                        .get(&h)
-                        .cloned()
-                        .unwrap_or_else(|| Err("not diagnosed".to_string()));
+                    let result = match r.by_hash.get(&h) {
+                        Some(Ok(f)) => Ok(f.clone()),
+                        Some(Err(why)) => Err(naming(why, &e.path)),
+                        None => Err("not diagnosed".to_string()),
+                    };
                     (Some(h), result)
                 }
             };
@@ -394,4 +408,22 @@ pub fn run_fleet(rig: &Rig, rig_file: Option<&Path>, args: &FleetArgs) -> Result
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::naming;
+    use std::path::Path;
+
+    #[test]
+    fn a_kept_refusal_names_the_rows_log() {
+        let kept = "bench log `/cluster/a/logs/x.csv`, line 39, column `t_s`: `x0.1` is not a finite number";
+        assert_eq!(
+            naming(kept, Path::new("logs/x.csv")),
+            "bench log `logs/x.csv`, line 39, column `t_s`: `x0.1` is not a finite number"
+        );
+        // Other reasons are the row's own already.
+        let other = "diagnosis of `logs/x.csv` killed by signal 9";
+        assert_eq!(naming(other, Path::new("logs/x.csv")), other);
+    }
 }
