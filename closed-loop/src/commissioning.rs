@@ -20,6 +20,7 @@ pub const COMMISSIONING: Scenario = Scenario {
     duration_s: LONGEST_S,
     steady_from_s: 0.0,
     events: [None; crate::scenario::MAX_EVENTS],
+    profile: None,
 };
 
 /// The longest a sequence may take in simulation before the run gives up. [s]

@@ -16,11 +16,14 @@
 #![no_std]
 #![deny(missing_docs)]
 
+pub mod bench_test;
 pub mod commissioning;
 pub mod config;
+pub mod profile;
 pub mod scenario;
 
 pub use config::controller_config;
+pub use profile::{Profile, Setpoint};
 pub use scenario::{by_name, Scenario, ScenarioKind, PROCEDURES, SCENARIOS};
 
 use firmware::io::{Measurements, Outputs};
@@ -55,6 +58,7 @@ pub struct ClosedLoop {
     period_s: f64,
     scenario: Scenario,
     next_event: usize,
+    profile_sent: u64,
     heartbeat_every: u32,
     steps: u64,
     external_torque_nm: f64,
@@ -107,6 +111,7 @@ impl ClosedLoop {
             period_s,
             scenario: *scenario,
             next_event: 0,
+            profile_sent: 0,
             heartbeat_every,
             steps: 0,
             external_torque_nm: 0.0,
@@ -205,6 +210,13 @@ impl ClosedLoop {
                 None => {
                     self.next_event += 1;
                 }
+            }
+        }
+        if let Some(p) = self.scenario.profile.filter(|_| self.bench_pc) {
+            // The k-th setpoint is due at k·period (within half a PWM period of rounding).
+            if t + 0.5 * self.period_s >= self.profile_sent as f64 * p.period_s {
+                let _ = self.controller.command(p.command_at(t));
+                self.profile_sent += 1;
             }
         }
         if self.bench_pc && self.steps % self.heartbeat_every as u64 == 0 {

@@ -1,7 +1,11 @@
-//! Named scenarios: the paper's low-speed pressure holding, pressure and speed steps, and a
-//! slow stroke of the payload — each a plant configuration, an initial state and the
-//! commands the bench PC sends at given times.
+//! Named scenarios: the paper's low-speed pressure holding, pressure and speed steps, a
+//! slow stroke of the payload, and the bench tests a diagnosis is run on (a pressure
+//! staircase, a sinusoidal pressure, a stroke out and back under speed control) — each a
+//! plant configuration, an initial state, the commands the bench PC sends at given times
+//! and, for a test whose setpoint moves, the [`Profile`] it streams.
 
+use crate::bench_test::{named, sine_test, staircase_test, stroke_test};
+use crate::profile::Profile;
 use firmware::{Command, Mode};
 
 /// Most commands a scenario sends.
@@ -22,6 +26,12 @@ pub enum ScenarioKind {
     Commissioning,
     /// The torque feed-forward's bench sweep: constant speed both ways, payload free.
     CompensationSweep,
+    /// Pressure levels held one after another on the blocked cylinder.
+    Staircase,
+    /// A sinusoidal pressure setpoint on the blocked cylinder.
+    Sine,
+    /// The payload moved out and back under speed control, reversing once.
+    Stroke,
 }
 
 /// A named scenario.
@@ -43,13 +53,28 @@ pub struct Scenario {
     pub steady_from_s: f64,
     /// Commands and when they are sent. [s]
     pub events: [Option<(f64, Command)>; MAX_EVENTS],
+    /// The setpoint the bench PC streams from the start, after the events due at the same
+    /// instant (`None`: only the events).
+    pub profile: Option<Profile>,
 }
 
 /// The paper's holding pressure. [Pa]
 pub const HOLD_PRESSURE_PA: f64 = 5e6;
 
+/// The named staircase: 0.5 → 4 MPa in 2.5 s, then 4, 7, 2.5 and 5.5 MPa for 4 s each.
+const STAIRCASE: Scenario = named(staircase_test(
+    &[(4e6, 4.0), (7e6, 4.0), (2.5e6, 4.0), (5.5e6, 4.0)],
+    2.5,
+));
+
+/// The named sine: 0.5 → 5 MPa in 3 s, 2 s held, then ±0.6 MPa at 0.2 Hz to 20 s.
+const SINE: Scenario = named(sine_test(5e6, 3.0, 2.0, 0.6e6, 0.2, 20.0));
+
+/// The named stroke: 20 rad/s (≈0.7 mm/s) out, reversed at 10.4 s, back to 20 s.
+const STROKE: Scenario = named(stroke_test(20.0, 0.5, 10.375, 20.0));
+
 /// Every scenario.
-pub const SCENARIOS: [Scenario; 4] = [
+pub const SCENARIOS: [Scenario; 7] = [
     Scenario {
         name: "pressure-hold",
         description: "the paper's low-speed pressure holding: blocked cylinder at 5 MPa, the pump turning only to replace leakage (about 60 rpm)",
@@ -66,6 +91,7 @@ pub const SCENARIOS: [Scenario; 4] = [
             None,
             None,
         ],
+        profile: None,
     },
     Scenario {
         name: "pressure-step",
@@ -85,6 +111,7 @@ pub const SCENARIOS: [Scenario; 4] = [
             None,
             None,
         ],
+        profile: None,
     },
     Scenario {
         name: "speed-step",
@@ -102,6 +129,7 @@ pub const SCENARIOS: [Scenario; 4] = [
             None,
             None,
         ],
+        profile: None,
     },
     Scenario {
         name: "slow-stroke",
@@ -119,7 +147,11 @@ pub const SCENARIOS: [Scenario; 4] = [
             None,
             None,
         ],
+        profile: None,
     },
+    STAIRCASE,
+    SINE,
+    STROKE,
 ];
 
 /// Speed of the torque feed-forward's bench sweep: 1.6 revolutions per second, so a
@@ -153,6 +185,7 @@ pub const PROCEDURES: [Scenario; 1] = [Scenario {
         None,
         None,
     ],
+    profile: None,
 }];
 
 /// The scenario or procedure called `name`.

@@ -244,12 +244,16 @@ pub enum ParseError {
     NoTag,
     /// A field is missing or out of order (its key).
     Missing(&'static str),
-    /// A field's value is not a number of its type (its key).
+    /// A field's value is not a number (its key).
     BadValue(&'static str),
+    /// A code field's value is not a whole number (its key).
+    NotWhole(&'static str),
     /// Unknown mode code.
     BadMode,
     /// Unknown fault code.
     BadFault,
+    /// A command status beyond its byte.
+    BadStatus,
 }
 
 impl fmt::Display for ParseError {
@@ -258,6 +262,7 @@ impl fmt::Display for ParseError {
             ParseError::NoTag => write!(f, "no `{LINE_TAG} ` tag in the line"),
             ParseError::Missing(k) => write!(f, "field `{k}` missing or out of order"),
             ParseError::BadValue(k) => write!(f, "field `{k}` is not a number"),
+            ParseError::NotWhole(k) => write!(f, "field `{k}` is not a whole number"),
             ParseError::BadMode => {
                 let last = (0..=u8::MAX)
                     .take_while(|c| Mode::from_code(*c).is_some())
@@ -271,8 +276,23 @@ impl fmt::Display for ParseError {
                 "field `fault` is not a fault code (0, none, or 1..={})",
                 FaultCode::MAX_CODE
             ),
+            ParseError::BadStatus => write!(f, "field `status` is not a status code (0..=255)"),
         }
     }
+}
+
+/// A code field's text: its byte, `None` for a whole number beyond a byte (a code no
+/// firmware sends, said as such by the caller), an error for anything but a whole number.
+fn code(text: &str, key: &'static str) -> Result<Option<u8>, ParseError> {
+    let digits = text.strip_prefix(['+', '-']).unwrap_or(text);
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(if text.parse::<f64>().is_ok() {
+            ParseError::NotWhole(key)
+        } else {
+            ParseError::BadValue(key)
+        });
+    }
+    Ok(text.parse::<u8>().ok())
 }
 
 /// Parses a version-1 line (anything before the first `EHA1 ` is ignored).
@@ -295,15 +315,9 @@ pub fn parse_line(line: &str) -> Result<TelemetryFrame, ParseError> {
     for (slot, key) in v.iter_mut().zip(&COLUMNS[1..]) {
         *slot = next(key)?.parse().map_err(|_| ParseError::BadValue(key))?;
     }
-    let mode: u8 = next("mode")?
-        .parse()
-        .map_err(|_| ParseError::BadValue("mode"))?;
-    let fault: u8 = next("fault")?
-        .parse()
-        .map_err(|_| ParseError::BadValue("fault"))?;
-    let status: u8 = next("status")?
-        .parse()
-        .map_err(|_| ParseError::BadValue("status"))?;
+    let mode = code(next("mode")?, "mode")?.ok_or(ParseError::BadMode)?;
+    let fault = code(next("fault")?, "fault")?.ok_or(ParseError::BadFault)?;
+    let status = code(next("status")?, "status")?.ok_or(ParseError::BadStatus)?;
     let [p_ref_pa, p_pa, speed_rad_s, iq_a, id_a, theta_m_rad, speed_ref_rad_s, iq_ref_a, ud_v, uq_v, udc_v] =
         v;
     Ok(TelemetryFrame {
@@ -394,6 +408,25 @@ mod tests {
             message.contains(&std::format!("1..={}", FaultCode::ALL.len())),
             "{message}"
         );
+        // A code beyond a byte or below zero is no code of the firmware, not "no number".
+        let replaced = |from: &str, to: &str| s.replace(from, to);
+        for (line, e) in [
+            (replaced(" mode=3 ", " mode=999 "), ParseError::BadMode),
+            (replaced(" mode=3 ", " mode=-1 "), ParseError::BadMode),
+            (replaced(" fault=9 ", " fault=-1 "), ParseError::BadFault),
+            (replaced(" fault=9 ", " fault=70000 "), ParseError::BadFault),
+            (replaced(" status=2", " status=256"), ParseError::BadStatus),
+            (
+                replaced(" mode=3 ", " mode=2.5 "),
+                ParseError::NotWhole("mode"),
+            ),
+            (
+                replaced(" mode=3 ", " mode=x "),
+                ParseError::BadValue("mode"),
+            ),
+        ] {
+            assert_eq!(parse_line(&line), Err(e), "{line}");
+        }
     }
 
     #[test]

@@ -11,7 +11,7 @@
 //! `eha tune` writes its proposal through this module; any other tool that changes
 //! parameters (a compensation table, a commissioning result) does the same.
 
-use crate::output::CliError;
+use crate::output::{CliError, Outputs};
 use firmware::can_protocol::{encode_command, encode_set_parameter, Frame, NodeId, Request};
 use firmware::parameters::ParamId;
 use std::fmt::Write as _;
@@ -96,17 +96,17 @@ pub fn candump_log(commands: &[CanCommand], start_s: f64) -> String {
     s
 }
 
-/// Writes the commands as a `candump -l` log to `path` (atomically), stamped from now.
-pub fn write_candump_log(path: &Path, commands: &[CanCommand]) -> Result<(), CliError> {
+/// Stages the commands as a `candump -l` log, stamped from now, as the output `--can-log
+/// path`.
+pub fn stage_candump_log(
+    out: &mut Outputs,
+    path: &Path,
+    commands: &[CanCommand],
+) -> Result<(), CliError> {
     let now = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64());
-    crate::output::atomic::write(path, candump_log(commands, now).as_bytes()).map_err(|source| {
-        CliError::Write {
-            file: path.to_path_buf(),
-            source,
-        }
-    })
+    out.file("--can-log", path, candump_log(commands, now).as_bytes())
 }
 
 #[cfg(test)]

@@ -2,8 +2,8 @@
 //! subcommand runs on (`--rig FILE` or the nominal rig), and the process's exit status.
 //!
 //! Each subcommand owns its arguments and its `run_*` function in its own module; this one
-//! only routes. What they report through (errors, standard output, JSON, atomic files) is
-//! [`crate::output`]. Exit status: 0 on success, 2 for bad input or arguments (clap's usage
+//! only routes. What they report through (errors, and their outputs as one transaction:
+//! files, folders, JSON, standard output) is [`crate::output`]. Exit status: 0 on success, 2 for bad input or arguments (clap's usage
 //! errors among them), 1 for anything else; the message goes to standard error. Nothing
 //! panics.
 
@@ -77,13 +77,21 @@ pub fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
-            // Usage errors go to stderr with status 2; --help and --version to stdout, 0.
+            // Usage errors go to stderr with status 2; --help and --version to stdout, 0,
+            // unless standard output cannot take them (a closed pipe is no error).
             let code = ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2));
             if e.use_stderr() {
                 let text = crate::values::shorten_long_words(&e.render().to_string());
                 let _ = write!(io::stderr(), "{text}");
-            } else {
-                let _ = e.print();
+            } else if let Err(why) = e.print().and_then(|()| io::stdout().flush()) {
+                if why.kind() != io::ErrorKind::BrokenPipe {
+                    let _ = writeln!(
+                        io::stderr(),
+                        "eha: error: cannot write standard output: {}",
+                        paths::describe(&why)
+                    );
+                    return ExitCode::FAILURE;
+                }
             }
             return code;
         }
@@ -91,6 +99,8 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            // An error the interruption's clean-up caused is not the process's to report.
+            interrupt::wait_if_interrupted();
             let _ = writeln!(io::stderr(), "eha: error: {e}");
             ExitCode::from(e.exit_status())
         }

@@ -14,11 +14,11 @@
 //! diagnose` and `eha tune`; re-capturing (or cutting the log at the reset) is the fix.
 
 use crate::bench_log::limits::{
-    line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS,
+    line_too_long, max_rows, physical_range, LineLimited, MAX_LINE_BYTES, MIN_SAMPLE_INTERVAL_S,
 };
-use crate::bench_log::{self, BenchLog, Signal, MIN_ROWS};
+use crate::bench_log::{self, time_problem, BenchLog, Problem, Signal, MIN_ROWS};
 use crate::output::paths::Declared;
-use crate::output::CliError;
+use crate::output::{CliError, Outputs};
 use clap::Args;
 use firmware::telemetry::{parse_line, ParseError, TelemetryFrame, COLUMNS};
 use std::fmt;
@@ -70,6 +70,14 @@ pub enum LineProblem {
         /// This frame's time. [s]
         value: f64,
     },
+    /// The frame follows the previous one closer in time than any sampler logs
+    /// ([`MIN_SAMPLE_INTERVAL_S`]).
+    IntervalTooShort {
+        /// The previous frame's time. [s]
+        previous: f64,
+        /// This frame's time. [s]
+        value: f64,
+    },
 }
 
 impl fmt::Display for LineProblem {
@@ -89,6 +97,12 @@ impl fmt::Display for LineProblem {
                 f,
                 "field `t_s`: time {value} s does not exceed the previous frame's {previous} s \
                  (controller reset?)"
+            ),
+            LineProblem::IntervalTooShort { previous, value } => write!(
+                f,
+                "field `t_s`: time {value} s follows the previous frame's {previous} s by \
+                 {:.3e} s; no sampler logs frames less than {MIN_SAMPLE_INTERVAL_S:e} s apart",
+                value - previous
             ),
         }
     }
@@ -168,9 +182,10 @@ pub enum IngestError {
     },
     /// More telemetry frames than a bench log may hold.
     #[error(
-        "defmt log `{}`: more than {MAX_ROWS} telemetry lines; a bench log holds at most that \
-         many rows (split the capture)",
-        file.display()
+        "defmt log `{}`: more than {} telemetry lines; a bench log of the telemetry's \
+         columns holds at most that many rows (split the capture)",
+        file.display(),
+        max_rows(COLUMNS.len())
     )]
     TooManyFrames {
         /// The file.
@@ -284,11 +299,15 @@ impl LineReader {
         if let Some((k, v)) = out_of_range_field(&frame) {
             return Line::Malformed(LineProblem::OutOfRange(k, v));
         }
-        if let Some(previous) = self.last_t.filter(|p| frame.t_s <= *p) {
-            return Line::Malformed(LineProblem::TimeNotIncreasing {
-                previous,
-                value: frame.t_s,
-            });
+        let value = frame.t_s;
+        match self.last_t.and_then(|p| Some((p, time_problem(p, value)?))) {
+            Some((previous, Problem::TimeNotIncreasing { .. })) => {
+                return Line::Malformed(LineProblem::TimeNotIncreasing { previous, value })
+            }
+            Some((previous, _)) => {
+                return Line::Malformed(LineProblem::IntervalTooShort { previous, value })
+            }
+            None => {}
         }
         self.last_t = Some(frame.t_s);
         Line::Frame(frame)
@@ -334,7 +353,7 @@ pub fn read<R: BufRead>(mut input: R, file: &Path) -> Result<(Ingested, usize), 
                 continue;
             }
         };
-        if out.frames() == MAX_ROWS {
+        if out.frames() == max_rows(COLUMNS.len()) {
             return Err(IngestError::TooManyFrames {
                 file: file.to_path_buf(),
             });
@@ -399,7 +418,9 @@ pub fn run_ingest(args: &IngestArgs) -> Result<(), CliError> {
         ("skipped_lines".into(), ingested.skipped.to_string()),
         ("faulted_frames".into(), ingested.faulted_frames.to_string()),
     ];
-    bench_log::write(&args.out, &ingested.log)?;
+    let mut out = Outputs::new();
+    bench_log::stage(&mut out, "--out", &args.out, &ingested.log)?;
+    out.commit()?;
     eprintln!(
         "ingest: {} telemetry lines of {lines} written to {} ({} other lines skipped, 0 \
          malformed{})",

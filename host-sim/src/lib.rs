@@ -2,8 +2,8 @@
 //! benchmarks too (the `eha` binary in `main.rs` only calls [`cli::main`]).
 //!
 //! - [`cli`]: the subcommands of `shared/contracts/eha-cli.md`, routed to the modules that
-//!   own them; [`output`]: what they report through (errors and exit status, standard
-//!   output, JSON, atomic files); [`values`]: the command line's number parsers.
+//!   own them; [`output`]: what they report through (errors and exit status, their outputs
+//!   as one transaction); [`values`]: the command line's number parsers.
 //! - [`bench_log`]: the bench-log CSV contract (`shared/contracts/bench-log.md`), read and
 //!   written.
 //! - [`rig_file`]: the rig-file format, TOML of [`plant_model::Rig`], and `eha rig`.

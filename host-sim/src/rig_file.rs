@@ -10,7 +10,7 @@
 //!
 //! `eha rig` ([`run_rig`]) prints a rig in this format.
 
-use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::output::{is_stdout, CliError, Outputs};
 use clap::Args;
 use plant_model::{Rig, RigError};
 use std::io::Read as _;
@@ -34,14 +34,15 @@ impl RigArgs {
 /// `eha rig`: the TOML on standard output; with `--json PATH` the JSON too (with `--json -`
 /// only the JSON, so standard output stays one parseable document).
 pub fn run_rig(rig: &Rig, a: &RigArgs) -> Result<(), CliError> {
+    let mut out = Outputs::new();
     if let Some(path) = &a.json {
         let value = serde_json::to_value(rig).map_err(|e| CliError::Failed(e.to_string()))?;
-        write_json(path, &value)?;
-        if is_stdout(path) {
-            return Ok(());
-        }
+        out.json("--json", path, &value)?;
     }
-    print_stdout(&to_toml(rig))
+    if !a.json.as_deref().is_some_and(is_stdout) {
+        out.print(&to_toml(rig));
+    }
+    out.commit()
 }
 
 /// A rig file that cannot be used.

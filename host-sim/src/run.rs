@@ -4,12 +4,12 @@
 //! would give (piston position, low-side pressure), and the true port pressure kept aside
 //! for the pulsation study.
 //!
-//! A run is bounded before it starts: it may log at most the bench log's
-//! [`MAX_ROWS`](crate::bench_log::limits::MAX_ROWS) rows ([`log_plan`]); [`first_unphysical`]
+//! A run is bounded before it starts: it may log at most the rows a bench log of its
+//! [`LOGGED_COLUMNS`] may hold ([`most_rows`], [`log_plan`]); [`first_unphysical`]
 //! finds where a run's state left the physical range (a rig the integration cannot follow),
 //! for the commands to report instead of writing it.
 
-use crate::bench_log::limits::{physical_range, MAX_ROWS};
+use crate::bench_log::limits::{max_rows, physical_range};
 use crate::bench_log::BenchLog;
 use crate::compensate::Feedforward;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
@@ -17,7 +17,7 @@ use firmware::config::Config;
 use firmware::parameters::ParamId;
 use firmware::Command;
 use indicatif::{ProgressBar, ProgressStyle};
-use plant_model::Rig;
+use plant_model::{Integrator, Rig};
 use std::time::{Duration, Instant};
 
 /// What a run produced.
@@ -35,6 +35,10 @@ pub struct Run {
     pub absorber_zeta: f64,
     /// Simulated seconds per wall-clock second.
     pub real_time_factor: f64,
+    /// Simulated seconds per second of the running thread's own CPU time (what the run
+    /// costs, whatever else the machine is doing; the wall-clock factor where the platform
+    /// has no thread clock).
+    pub cpu_real_time_factor: f64,
 }
 
 /// Options of a run.
@@ -53,6 +57,18 @@ pub struct RunOptions {
     /// controller before the run, and enabled, as the drive loads it from flash (`None`:
     /// uncompensated).
     pub compensation: Option<Feedforward>,
+    /// The plant's integration scheme (the exponential one by default).
+    pub integrator: Integrator,
+}
+
+/// The bench-log columns a run logs: the six required, the shaft angle, piston position,
+/// low-side pressure, speed and current references and the three voltages.
+pub const LOGGED_COLUMNS: usize = 14;
+
+/// The most rows a run logs: those of a bench log of [`LOGGED_COLUMNS`] columns (the run
+/// keeps two columns of truth beside them, 16 values a row, under 1 GiB at this bound).
+pub const fn most_rows() -> usize {
+    max_rows(LOGGED_COLUMNS)
 }
 
 /// How a run of `duration_s` [s] is logged at `log_rate_hz` [Hz] with the PWM period
@@ -100,7 +116,7 @@ pub fn load_compensation(cl: &mut ClosedLoop, ff: &Feedforward) -> Result<(), St
 
 /// Runs `scenario` on the plant `plant_rig`, controlled by the configuration of
 /// `controller_rig` (the rig file the engineer believes in). Fails before any work if the
-/// log would exceed [`MAX_ROWS`].
+/// log would exceed [`most_rows`].
 pub fn run(
     plant_rig: &Rig,
     controller_rig: &Rig,
@@ -120,14 +136,17 @@ pub fn run_with_config(
 ) -> Result<Run, String> {
     let mut cl =
         ClosedLoop::new(plant_rig, config, scenario, opt.seed).map_err(|e| e.to_string())?;
+    cl.plant_mut().set_integrator(opt.integrator);
     if let Some(table) = &opt.compensation {
         load_compensation(&mut cl, table)?;
     }
     let (every, rows) = log_plan(opt.duration_s, opt.log_rate_hz, cl.period_s());
-    if rows.is_nan() || rows > MAX_ROWS as f64 {
+    if rows.is_nan() || rows > most_rows() as f64 {
         return Err(format!(
-            "{} s at {} Hz would log {rows:.0} rows; a bench log holds at most {MAX_ROWS}",
-            opt.duration_s, opt.log_rate_hz
+            "{} s at {} Hz would log {rows:.0} rows; a bench log of its columns holds at most {}",
+            opt.duration_s,
+            opt.log_rate_hz,
+            most_rows()
         ));
     }
     let n_rows = rows as usize;
@@ -151,6 +170,7 @@ pub fn run_with_config(
         None
     };
     let started = Instant::now();
+    let cpu_started = thread_cpu_s();
     let mut k = 0u64;
     cl.run(opt.duration_s, every, |s| {
         let t = &s.telemetry;
@@ -185,6 +205,10 @@ pub fn run_with_config(
         b.finish_and_clear();
     }
     let wall = started.elapsed().as_secs_f64();
+    let cpu = match (cpu_started, thread_cpu_s()) {
+        (Some(a), Some(b)) => b - a,
+        _ => wall,
+    };
     let [theta, x, p_low, w_ref, iq_ref, ud, uq, udc] = cols;
     log.theta_m_rad = Some(theta);
     log.x_m = Some(x);
@@ -218,5 +242,51 @@ pub fn run_with_config(
         absorber_fn_hz: fn_hz,
         absorber_zeta: zeta,
         real_time_factor: opt.duration_s / wall.max(1e-9),
+        cpu_real_time_factor: opt.duration_s / cpu.max(1e-9),
     })
+}
+
+/// The calling thread's CPU time (user and system), if the platform has a thread clock. [s]
+#[cfg(unix)]
+fn thread_cpu_s() -> Option<f64> {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the call only writes it.
+    let r = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (r == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+}
+
+/// The calling thread's CPU time: none without a thread clock. [s]
+#[cfg(not(unix))]
+fn thread_cpu_s() -> Option<f64> {
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_run_logs_the_columns_its_row_bound_counts() {
+        let rig = Rig::nominal();
+        let scenario = closed_loop::by_name("pressure-hold").unwrap();
+        let r = run(
+            &rig,
+            &rig,
+            scenario,
+            &RunOptions {
+                duration_s: 0.01,
+                log_rate_hz: 2000.0,
+                seed: 1,
+                progress: false,
+                metadata: Vec::new(),
+                compensation: None,
+                integrator: Default::default(),
+            },
+        )
+        .unwrap();
+        assert_eq!(r.log.columns().count(), LOGGED_COLUMNS);
+    }
 }

@@ -26,7 +26,7 @@ pub mod step;
 
 use crate::bench_log::BenchLog;
 use crate::output::paths::Declared;
-use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::output::{is_stdout, CliError, Outputs};
 use crate::values::{non_negative_f64, positive_f64, show};
 use can::Setting;
 use clap::{Args, ValueEnum};
@@ -253,6 +253,7 @@ pub fn tune(
             response[k + 1] * scale
         )));
     }
+    check_followed(kind, log, response, &step)?;
     let measured = step::metrics(&log.t_s, response, &step, signal);
     let mut notes = Vec::new();
     let job = Job {
@@ -343,6 +344,44 @@ pub fn tune(
         replayed_current,
         notes,
     })
+}
+
+/// Refuses a step the loop's response did not follow at least [`step::MIN_FOLLOWED`] of
+/// the way: no plant of the loop is identified from a response that is not one (an open
+/// loop, a saturated drive, a sensor that is not the column), and no gains proposed.
+fn check_followed(
+    kind: LoopKind,
+    log: &BenchLog,
+    response: &[f64],
+    step: &Step,
+) -> Result<(), TuneError> {
+    let (signal, column, reference, unit, scale) = match kind {
+        LoopKind::Speed => (
+            Signal::Speed,
+            "speed_rad_s",
+            "speed_ref_rad_s",
+            "rad/s",
+            1.0,
+        ),
+        LoopKind::Pressure => (Signal::Pressure, "p_pa", "p_ref_pa", "MPa", 1e-6),
+    };
+    let part = step::followed(&log.t_s, response, step, signal);
+    if part >= step::MIN_FOLLOWED {
+        return Ok(());
+    }
+    let end = step.end.min(log.len()).saturating_sub(1);
+    Err(TuneError::BadLog(format!(
+        "the log's {column} does not follow its {reference} step from {:.3} to {:.3} {unit} at \
+         t = {:.3} s: it comes {:.0} % of the way by t = {:.3} s (at least {:.0} % is a loop \
+         following its setpoint); no plant can be identified from it, so no gains are \
+         proposed (is the loop closed, the drive saturated, {column} the loop's sensor?)",
+        step.from * scale,
+        step.to * scale,
+        log.t_s[step.start],
+        100.0 * part.max(0.0),
+        log.t_s[end],
+        100.0 * step::MIN_FOLLOWED
+    )))
 }
 
 /// What each loop's tuning starts from.
@@ -510,14 +549,15 @@ pub fn run_tune(rig: &Rig, args: &TuneArgs) -> Result<(), CliError> {
     let t = t?;
     let frames = can::parameter_commands(&t.settings).map_err(CliError::Failed)?;
     let commands = crate::can_commands::cansend_lines(&frames);
+    let mut out = Outputs::new();
     if let Some(path) = &args.can_log {
-        crate::can_commands::write_candump_log(path, &frames)?;
+        crate::can_commands::stage_candump_log(&mut out, path, &frames)?;
     }
     if let Some(path) = &args.json {
-        write_json(path, &t.to_json(&commands))?;
-        if is_stdout(path) {
-            return Ok(());
-        }
+        out.json("--json", path, &t.to_json(&commands))?;
     }
-    print_stdout(&t.to_text(&commands))
+    if !args.json.as_deref().is_some_and(is_stdout) {
+        out.print(&t.to_text(&commands));
+    }
+    out.commit()
 }

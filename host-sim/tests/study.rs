@@ -28,6 +28,7 @@ fn dominant_with(effect: &str) -> (f64, f64) {
             progress: false,
             metadata: vec![],
             compensation: None,
+            integrator: Default::default(),
         },
     )
     .unwrap();

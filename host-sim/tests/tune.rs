@@ -31,6 +31,7 @@ fn log_of(plant: &Rig, controller: &Rig, scenario: &str) -> BenchLog {
             progress: false,
             metadata: Vec::new(),
             compensation: None,
+            integrator: Default::default(),
         },
     )
     .expect("the run succeeds")

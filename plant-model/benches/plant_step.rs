@@ -1,12 +1,13 @@
-//! One plant step (one 50 µs PWM period: one RK4 step at the default h_max) at the nominal
-//! rig in the paper's low-speed pressure-holding state (blocked cylinder, 5 MPa, shaft at
-//! ≈ 60 rpm), with the catalogue's effects off and with every low-speed effect on.
+//! One plant step (one 50 µs PWM period: one step at the default h_max) at the nominal rig in
+//! the paper's low-speed pressure-holding state (blocked cylinder, 5 MPa, shaft at ≈ 60 rpm),
+//! with the catalogue's effects off and with every low-speed effect on, by the exponential
+//! integrator (the default) and by RK4 (the scheme before it).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use plant_model::{Effect, InitialConditions, Inputs, Plant, Rig};
+use plant_model::{Effect, InitialConditions, Inputs, Integrator, Plant, Rig};
 use std::hint::black_box;
 
-fn holding_plant(effects: &[&str]) -> Plant {
+fn holding_plant(effects: &[&str], integrator: Integrator) -> Plant {
     let mut rig = Rig::nominal();
     rig.cylinder.blocked = true;
     for e in effects {
@@ -16,7 +17,9 @@ fn holding_plant(effects: &[&str]) -> Plant {
         omega_rad_s: 6.0,
         ..InitialConditions::holding(&rig, 5e6)
     };
-    Plant::new(&rig, &init, 1).expect("valid rig")
+    let mut plant = Plant::new(&rig, &init, 1).expect("valid rig");
+    plant.set_integrator(integrator);
+    plant
 }
 
 fn bench(c: &mut Criterion) {
@@ -34,22 +37,24 @@ fn bench(c: &mut Criterion) {
             ][..],
         ),
     ] {
-        let mut plant = holding_plant(effects);
-        // A slowly rotating voltage vector keeps every term of the step busy.
-        let mut k = 0u32;
-        group.bench_function(label, |b| {
-            b.iter(|| {
-                k = k.wrapping_add(1);
-                let a = (k as f64) * 1e-3;
-                let d = [
-                    0.5 + 0.01 * a.sin(),
-                    0.5 + 0.01 * (a - 2.1).sin(),
-                    0.5 + 0.01 * (a + 2.1).sin(),
-                ];
-                plant.advance(50e-6, &Inputs::duties(d, true));
-                black_box(plant.sample())
-            })
-        });
+        for integrator in [Integrator::Exponential, Integrator::Rk4 { substeps: 1 }] {
+            let mut plant = holding_plant(effects, integrator);
+            // A slowly rotating voltage vector keeps every term of the step busy.
+            let mut k = 0u32;
+            group.bench_function(format!("{label}/{}", integrator.name()), |b| {
+                b.iter(|| {
+                    k = k.wrapping_add(1);
+                    let a = (k as f64) * 1e-3;
+                    let d = [
+                        0.5 + 0.01 * a.sin(),
+                        0.5 + 0.01 * (a - 2.1).sin(),
+                        0.5 + 0.01 * (a + 2.1).sin(),
+                    ];
+                    plant.advance(50e-6, &Inputs::duties(d, true));
+                    black_box(plant.sample())
+                })
+            });
+        }
     }
     group.finish();
 }

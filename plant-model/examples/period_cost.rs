@@ -4,14 +4,15 @@
 //! paper's low-speed effects on. The workload for instruction counts:
 //!
 //! ```text
-//! valgrind --tool=callgrind target/release/examples/period_cost 20000
+//! valgrind --tool=callgrind target/release/examples/period_cost 20000 [INTEGRATOR]
 //! ```
 //!
 //! Run it with two period counts and divide the difference of the totals by the difference
-//! of the counts for the cost of one period, free of start-up.
+//! of the counts for the cost of one period, free of start-up. INTEGRATOR is one of
+//! `exponential` (the default), `rk4`, `rk4-quarter`.
 
 use plant_model::effects::paper_low_speed_effects;
-use plant_model::{InitialConditions, Inputs, Plant, Rig};
+use plant_model::{InitialConditions, Inputs, Integrator, Plant, Rig};
 use std::hint::black_box;
 
 fn main() {
@@ -19,6 +20,13 @@ fn main() {
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(20_000);
+    let integrator = match std::env::args().nth(2) {
+        Some(name) => Integrator::from_name(&name).unwrap_or_else(|| {
+            eprintln!("period_cost: unknown integrator `{name}`");
+            std::process::exit(2)
+        }),
+        None => Integrator::default(),
+    };
     let mut rig = Rig::nominal();
     rig.cylinder.blocked = true;
     for e in paper_low_speed_effects() {
@@ -29,6 +37,7 @@ fn main() {
         ..InitialConditions::holding(&rig, 5e6)
     };
     let mut plant = Plant::new(&rig, &init, 1).expect("valid rig");
+    plant.set_integrator(integrator);
     let u_dc = rig.inverter.u_dc_v;
     let p_n = rig.motor.pole_pairs as f64;
     for _ in 0..periods {
@@ -46,7 +55,9 @@ fn main() {
     }
     let o = plant.observe();
     println!(
-        "{periods} periods: ω {:.3} rad/s, p_A {:.1} Pa",
-        o.omega_m_rad_s, o.p_a_pa
+        "{periods} periods ({}): ω {:.3} rad/s, p_A {:.1} Pa",
+        integrator.name(),
+        o.omega_m_rad_s,
+        o.p_a_pa
     );
 }

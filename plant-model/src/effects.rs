@@ -25,7 +25,9 @@ pub enum Effect {
     CoggingTorque {
         /// Amplitude. [N·m]
         amplitude_nm: f64,
-        /// Cycles per mechanical revolution (0: LCM(slots, poles) of the rig). [1]
+        /// Cycles per mechanical revolution, 1 to [`MAX_COGGING_ORDER`]; 0 stands for the
+        /// rig's own, LCM(slots, poles), when `order` is not given ([`Effect::resolved`]
+        /// says which). [1]
         order: u32,
         /// Phase. [rad]
         phase_rad: f64,
@@ -99,6 +101,11 @@ pub const EFFECT_NAMES: [&str; 12] = [
     "current_sensor_offset",
 ];
 
+/// The highest cogging order `order` may name: at one revolution per second its torque
+/// already beats at 10 kHz, the Nyquist rate of the 20 kHz current loop, so the controller
+/// could not see a higher one; real motors' LCM(slots, poles) lie in the tens to hundreds.
+pub const MAX_COGGING_ORDER: u32 = 10_000;
+
 /// Why an effect specification was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EffectError {
@@ -108,21 +115,40 @@ pub enum EffectError {
     UnknownParameter,
     /// `param=value` was expected.
     Malformed,
-    /// The value is not a finite number (or not a whole number where one is needed).
+    /// The value is not a finite number.
     BadValue,
+    /// A count (pistons, an order) that is not a whole number from `min` to `max`.
+    NotWhole {
+        /// The parameter.
+        param: &'static str,
+        /// Its least value.
+        min: u32,
+        /// Its greatest value.
+        max: u32,
+    },
     /// The value is outside the parameter's physical range.
     OutOfRange,
 }
 
 impl core::fmt::Display for EffectError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(match self {
-            EffectError::UnknownEffect => "unknown effect name",
-            EffectError::UnknownParameter => "unknown parameter for this effect",
-            EffectError::Malformed => "expected `param=value`",
-            EffectError::BadValue => "value is not a finite number",
-            EffectError::OutOfRange => "value is outside the parameter's physical range",
-        })
+        match self {
+            EffectError::UnknownEffect => f.write_str("unknown effect name"),
+            EffectError::UnknownParameter => f.write_str("unknown parameter for this effect"),
+            EffectError::Malformed => f.write_str("expected `param=value`"),
+            EffectError::BadValue => f.write_str("value is not a finite number"),
+            EffectError::NotWhole { param, min, max } => {
+                write!(f, "`{param}` takes a whole number from {min} to {max}")?;
+                if *param == "order" {
+                    // The catalogue's default is the rig's own order; 0 never means it.
+                    f.write_str(" (leave it out for the rig's LCM(slots, poles))")?;
+                }
+                Ok(())
+            }
+            EffectError::OutOfRange => {
+                f.write_str("value is outside the parameter's physical range")
+            }
+        }
     }
 }
 
@@ -279,15 +305,17 @@ impl Effect {
 
     /// Sets one parameter by its contract name.
     pub fn set(&mut self, param: &str, v: f64) -> Result<(), EffectError> {
-        let whole = |v: f64| -> Result<u32, EffectError> {
-            if v >= 0.0 && v <= u32::MAX as f64 && libm::floor(v) == v {
+        let whole = |param: &'static str, min: u32, max: u32| -> Result<u32, EffectError> {
+            if v >= f64::from(min) && v <= f64::from(max) && libm::floor(v) == v {
                 Ok(v as u32)
             } else {
-                Err(EffectError::BadValue)
+                Err(EffectError::NotWhole { param, min, max })
             }
         };
         match (self, param) {
-            (Effect::PistonRipple { pistons, .. }, "pistons") => *pistons = whole(v)?,
+            (Effect::PistonRipple { pistons, .. }, "pistons") => {
+                *pistons = whole("pistons", 3, 31)?
+            }
             (
                 Effect::PistonRipple {
                     amplitude_ratio, ..
@@ -295,7 +323,9 @@ impl Effect {
                 "amplitude_ratio",
             ) => *amplitude_ratio = v,
             (Effect::CoggingTorque { amplitude_nm, .. }, "amplitude_nm") => *amplitude_nm = v,
-            (Effect::CoggingTorque { order, .. }, "order") => *order = whole(v)?,
+            (Effect::CoggingTorque { order, .. }, "order") => {
+                *order = whole("order", 1, MAX_COGGING_ORDER)?
+            }
             (Effect::CoggingTorque { phase_rad, .. }, "phase_rad") => *phase_rad = v,
             (Effect::FluxHarmonics { t6_ratio, .. }, "t6_ratio") => *t6_ratio = v,
             (Effect::FluxHarmonics { phase_rad, .. }, "phase_rad") => *phase_rad = v,
@@ -358,6 +388,23 @@ impl Effect {
             Ok(())
         } else {
             Err(EffectError::OutOfRange)
+        }
+    }
+
+    /// The effect as it acts on `rig`, every default stated: the cogging order left out
+    /// (0) becomes the rig's LCM(slots, poles). What a log's metadata should record.
+    pub fn resolved(&self, rig: &Rig) -> Effect {
+        match *self {
+            Effect::CoggingTorque {
+                amplitude_nm,
+                order: 0,
+                phase_rad,
+            } => Effect::CoggingTorque {
+                amplitude_nm,
+                order: rig.motor.cogging_fundamental_order(),
+                phase_rad,
+            },
+            e => e,
         }
     }
 
@@ -490,10 +537,30 @@ mod tests {
             Effect::parse("dead_time:dead_time_s=inf"),
             Err(EffectError::BadValue)
         );
-        assert_eq!(
-            Effect::parse("piston_ripple:pistons=8.5"),
-            Err(EffectError::BadValue)
-        );
+        let pistons = Err(EffectError::NotWhole {
+            param: "pistons",
+            min: 3,
+            max: 31,
+        });
+        assert_eq!(Effect::parse("piston_ripple:pistons=8.5"), pistons);
+        assert_eq!(Effect::parse("piston_ripple:pistons=2"), pistons);
+        // Counts say they are counts, whatever is wrong with them; 0 is no cogging order.
+        let order = EffectError::NotWhole {
+            param: "order",
+            min: 1,
+            max: MAX_COGGING_ORDER,
+        };
+        for spec in [
+            "cogging_torque:order=0.5",
+            "cogging_torque:order=-3",
+            "cogging_torque:order=1e30",
+            "cogging_torque:order=0",
+        ] {
+            assert_eq!(Effect::parse(spec), Err(order), "{spec}");
+        }
+        extern crate std;
+        use std::string::ToString;
+        assert!(order.to_string().contains("whole number from 1 to 10000"));
         assert_eq!(
             Effect::parse("entrained_air:effective_bulk_modulus_pa=-3"),
             Err(EffectError::OutOfRange)

@@ -68,16 +68,48 @@ impl Inverter {
     /// `i_abc` (positive into the motor). [V]
     #[inline]
     pub fn pole_voltages(&self, duties: &[f64; 3], i_abc: &[f64; 3]) -> [f64; 3] {
-        let mut v = [0.0; 3];
-        for ((v, d), i) in v.iter_mut().zip(duties).zip(i_abc) {
-            let err = if self.dead_time_error_v > 0.0 {
-                self.dead_time_error_v * (i / self.band_a).clamp(-1.0, 1.0)
+        let drop = self.dead_time_drop(i_abc);
+        [
+            duties[0] * self.u_dc_v - drop[0],
+            duties[1] * self.u_dc_v - drop[1],
+            duties[2] * self.u_dc_v - drop[2],
+        ]
+    }
+
+    /// The dead time's drop split at phase currents `i_abc`: each pole's constant part
+    /// (±t_d·f_pwm·U_dc outside the current band, 0 inside) and the band's slope
+    /// t_d·f_pwm·U_dc/band, the resistance a phase inside it sees. [V], [Ω]
+    #[inline]
+    pub fn dead_time_parts(&self, i_abc: &[f64; 3]) -> ([f64; 3], f64) {
+        let e = self.dead_time_error_v;
+        let out = |i: f64| {
+            if i >= self.band_a {
+                e
+            } else if i <= -self.band_a {
+                -e
             } else {
                 0.0
-            };
-            *v = d * self.u_dc_v - err;
+            }
+        };
+        (i_abc.map(out), e / self.band_a)
+    }
+
+    /// The dead time's current band. [A]
+    #[inline]
+    pub fn band(&self) -> f64 {
+        self.band_a
+    }
+
+    /// What the dead time takes off each pole's average voltage at phase currents `i_abc`
+    /// (positive into the motor): t_d·f_pwm·U_dc·sign(i), fading linearly within the current
+    /// band. [V]
+    #[inline]
+    pub fn dead_time_drop(&self, i_abc: &[f64; 3]) -> [f64; 3] {
+        if self.dead_time_error_v > 0.0 {
+            i_abc.map(|i| self.dead_time_error_v * (i / self.band_a).clamp(-1.0, 1.0))
+        } else {
+            [0.0; 3]
         }
-        v
     }
 }
 

@@ -28,7 +28,7 @@ pub mod valves;
 pub use effects::Effect;
 pub use faults::PlantFaults;
 pub use plant::{
-    CurrentWatch, Drive, EnergyBalance, InitialConditions, Inputs, Observables, Plant,
+    CurrentWatch, Drive, EnergyBalance, InitialConditions, Inputs, Integrator, Observables, Plant,
 };
 pub use rig::{Rig, RigError};
 pub use sensor_faults::SensorFaults;

@@ -122,6 +122,10 @@ pub struct MagnetFlux {
     pub d_slope_wb: f64,
     /// ∂ψ_qf/∂θ_e. [Wb/rad]
     pub q_slope_wb: f64,
+    /// ∂²ψ_df/∂θ_e². [Wb/rad²]
+    pub d_curvature_wb: f64,
+    /// ∂²ψ_qf/∂θ_e². [Wb/rad²]
+    pub q_curvature_wb: f64,
 }
 
 /// The motor's equations, precomputed from [`MotorParams`] (only active harmonics kept).
@@ -214,6 +218,8 @@ impl Motor {
             q_wb: 0.0,
             d_slope_wb: 0.0,
             q_slope_wb: 0.0,
+            d_curvature_wb: 0.0,
+            q_curvature_wb: 0.0,
         };
         for t in self.flux_terms.iter().take(self.n_flux_terms) {
             let base = e.pow(t.multiple);
@@ -223,6 +229,8 @@ impl Motor {
             f.q_wb += q.sin;
             f.d_slope_wb -= m * d.sin;
             f.q_slope_wb += m * q.cos;
+            f.d_curvature_wb -= m * m * d.cos;
+            f.q_curvature_wb -= m * m * q.sin;
         }
         f
     }

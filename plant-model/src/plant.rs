@@ -15,33 +15,33 @@
 //! conserved.
 //!
 //! # Integration
-//! Classical fourth-order Runge–Kutta with a fixed step h = dt/⌈dt/h_max⌉ inside each call,
-//! h_max = 50 µs by default (one step per 20 kHz PWM period). Why this scheme: the plant is
-//! mildly stiff at most — the fastest linear modes at the nominal rig are the check valve
-//! against a chamber near its end stop (G/C ≈ 1e-9/1.5e-13 ≈ 7e3 s⁻¹), the oil column of the
-//! absorber inlet against chamber 1 (1/√(I·C_oil) ≈ 2e3 rad/s) and the electrical poles
-//! (R/L ≈ 180 s⁻¹, ω_e up to ≈ 1.3e3 rad/s), so |λ·h| ≤ 0.35 sits well inside RK4's stability
-//! interval (|λh| < 2.78 on the real axis) and its error is O(h⁴). An implicit scheme would
-//! buy nothing at this step and cost a Jacobian. The discontinuities (stick/slip, poppet
-//! closure, diode extinction) are handled at step boundaries by projection (their energy is
-//! booked, see below) so RK4 never integrates across a switching surface with a stale sign.
-//! The fine-step comparison is in this crate's tests (`integration_error_against_fine_step`).
+//! A fixed step h = dt/⌈dt/h_max⌉ inside each call, h_max = 50 µs by default (one step per
+//! 20 kHz PWM period), by one of two schemes ([`Integrator`]):
+//! - the exponential scheme ([`exponential`], the default): the winding currents and the
+//!   hydraulic block (port A, the absorber's inlet, port B, the payload) solved exactly over
+//!   the step, the slow rest by third-order exponential Adams–Bashforth, one evaluation of
+//!   the model per step;
+//! - classical RK4 over the whole state ([`rk4`]), the scheme before it: the accuracy
+//!   reference at a quarter of the step, and the path of the faulted plant and of the
+//!   replays' prescribed currents, speed and piston.
 //!
-//! Cost: everything that depends on the shaft angle alone (rotor phasors, magnet-flux
-//! harmonics, cogging, the pump's displacement factor) is evaluated once per RK4 stage and
-//! kept for the step's end state, where `sample`, `observe`, the projection and the next
-//! step's first stage all read it. The stage phasors come from the step's start phasor
-//! rotated through the stage's angle increment (a Taylor series exact to rounding for the
-//! ≤ 0.1 rad a step turns, libm beyond), and the end phasor is carried to the next step the
-//! same way, recomputed from the angle every 1024 steps — no `sincos` in the steady loop,
-//! and the same numbers to ≈ 1e-16 rad. `observe` evaluates only the drive side (no state
-//! derivative), and the projection evaluates the model only for a body that can switch (not
-//! for a blocked or prescribed piston). The scheme itself — one RK4 step over all 19 states —
-//! is unchanged.
+//! Both locate the switching events inside a step (stick/slip, poppet closure, end stops) by
+//! regula falsi and handle the discontinuities at the located instant by projection (their
+//! energy is booked, see below), so neither integrates across a switching surface with a
+//! stale sign. The transducer's first-order lag is filtered exactly after each step
+//! (`Plant::filter_pressure_sensor`), stable for any time constant. The fine-step
+//! comparison is in this crate's tests (`integration_error_against_fine_step`), the closed
+//! loop's in `tests/tests/integrator_accuracy.rs`.
+//!
+//! Everything that depends on the shaft angle alone (rotor phasors, magnet-flux harmonics,
+//! cogging, the pump's displacement factor) is kept for the step's end state, where
+//! `sample`, `observe`, the projection and the next step all read it; the phasors are carried
+//! from step to step by rotation (a Taylor series exact to rounding for the ≤ 0.1 rad a step
+//! turns), recomputed from the angle every 1024 steps — no `sincos` in the steady loop.
 //!
 //! # Energy
 //! Input, losses and the work of projections are integrated as extra states with the same
-//! RK4, the stored energy is a function of the state, so
+//! scheme, the stored energy is a function of the state, so
 //! `input − Δstored − losses − external work − projection losses` must vanish up to the
 //! constant-β approximation of oil compression energy (order p/2β of the boundary work).
 
@@ -57,7 +57,9 @@ use crate::rig::{Rig, RigError};
 use crate::sensors::{SensorReadings, Sensors};
 use crate::valves::Valve;
 
+mod exponential;
 mod faulted;
+mod rk4;
 pub use faulted::CurrentWatch;
 
 /// State indices.
@@ -91,8 +93,6 @@ mod ix {
 
 type Vector = [f64; ix::N];
 
-/// Event functions: shaft friction, piston friction, absorber empty.
-const EVENTS: usize = 3;
 /// Events handled inside one step before the rest of it is taken plainly.
 const MAX_EVENTS_PER_STEP: usize = 6;
 /// Most refinements of an event's time.
@@ -148,6 +148,61 @@ impl Inputs {
             piston: None,
             external_force_n: 0.0,
             external_torque_nm: 0.0,
+        }
+    }
+}
+
+/// The integration scheme of [`Plant::advance`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Integrator {
+    /// The default ([`exponential`] module): the winding currents and the port-A node with
+    /// the absorber's inlet solved exactly over each step, the rest by second-order
+    /// exponential Adams–Bashforth, one model evaluation per step.
+    #[default]
+    Exponential,
+    /// Classical fourth-order Runge–Kutta over the whole state ([`rk4`] module), `substeps`
+    /// equal steps per step of the rig (1: the plant's integrator before the exponential
+    /// scheme; 4: the accuracy reference at a quarter of the step).
+    Rk4 {
+        /// Steps per step of the rig (1 to 64).
+        substeps: u32,
+    },
+}
+
+/// Most RK4 substeps per step of the rig.
+const MAX_SUBSTEPS: u32 = 64;
+
+impl Integrator {
+    /// The names [`Integrator::from_name`] takes, with what each is.
+    pub const NAMES: [(&'static str, &'static str); 3] = [
+        (
+            "exponential",
+            "exact linear blocks + exponential Adams–Bashforth 2, the default",
+        ),
+        ("rk4", "classical Runge–Kutta at the step of the rig"),
+        (
+            "rk4-quarter",
+            "classical Runge–Kutta at a quarter of it, the accuracy reference",
+        ),
+    ];
+
+    /// By name (one of [`Integrator::NAMES`]).
+    pub fn from_name(name: &str) -> Option<Integrator> {
+        match name {
+            "exponential" => Some(Integrator::Exponential),
+            "rk4" => Some(Integrator::Rk4 { substeps: 1 }),
+            "rk4-quarter" => Some(Integrator::Rk4 { substeps: 4 }),
+            _ => None,
+        }
+    }
+
+    /// Its name: one of [`Integrator::NAMES`], or `rk4/N` for other substeps.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Exponential => "exponential",
+            Integrator::Rk4 { substeps: 1 } => "rk4",
+            Integrator::Rk4 { substeps: 4 } => "rk4-quarter",
+            Integrator::Rk4 { .. } => "rk4/N",
         }
     }
 }
@@ -273,7 +328,7 @@ impl EnergyBalance {
 }
 
 /// Discrete state held over a step.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Discrete {
     shaft: Slip,
     piston: Slip,
@@ -383,6 +438,11 @@ pub struct Plant {
     i_fault: f64,
     oil_density: f64,
     protection: faulted::Protection,
+    integrator: Integrator,
+    /// The exponential integrator's rates, their slope and its linear blocks.
+    exp: exponential::History,
+    /// The transducer lag's discrete filter for a step: (h, e^{−h/τ}, τ/h·(1 − e^{−h/τ})).
+    lag_filter: (f64, f64, f64),
 }
 
 impl Plant {
@@ -487,6 +547,8 @@ impl Plant {
                     q_wb: 0.0,
                     d_slope_wb: 0.0,
                     q_slope_wb: 0.0,
+                    d_curvature_wb: 0.0,
+                    q_curvature_wb: 0.0,
                 },
                 t_cog: 0.0,
                 factor: 1.0,
@@ -497,8 +559,12 @@ impl Plant {
             i_fault: 0.0,
             oil_density: rig.oil.density_kg_m3,
             protection: faulted::Protection::default(),
+            integrator: Integrator::default(),
+            exp: exponential::History::default(),
+            lag_filter: (f64::NAN, 0.0, 0.0),
         };
         plant.angle = plant.angle_terms(init.theta_m_rad);
+        plant.exp = exponential::History::new(&plant.motor, &plant.inverter);
         plant.stored0_j = plant.stored_energy_j(&plant.x);
         Ok(plant)
     }
@@ -515,6 +581,18 @@ impl Plant {
         self.x[ix::THETA] = theta;
         self.rotor = RotorPhasor::at(theta);
         self.angle = self.angle_terms_of(theta, self.rotor.phasor);
+        self.exp.reset();
+    }
+
+    /// The integration scheme from now on (see [`Integrator`]).
+    pub fn set_integrator(&mut self, integrator: Integrator) {
+        self.integrator = integrator;
+        self.exp.reset();
+    }
+
+    /// The integration scheme in use.
+    pub fn integrator(&self) -> Integrator {
+        self.integrator
     }
 
     /// The shaft's true angle, unwrapped (what [`Plant::observe`] reports as `theta_m_rad`,
@@ -545,132 +623,61 @@ impl Plant {
         self.gate_enable(&mut inputs);
         self.last_inputs = inputs;
         let n = libm::ceil(dt_s / self.max_step_s).clamp(1.0, 1e9) as u64;
-        let h = dt_s / n as f64;
+        let (n, h) = match self.integrator {
+            Integrator::Rk4 { substeps } => {
+                let s = u64::from(substeps.clamp(1, MAX_SUBSTEPS));
+                (n * s, dt_s / (n * s) as f64)
+            }
+            Integrator::Exponential => (n, dt_s / n as f64),
+        };
         if self.faulted {
             self.advance_faulted(n, h, inputs);
         } else {
+            let exponential = self.integrator == Integrator::Exponential;
             for _ in 0..n {
                 self.impose(&inputs);
-                self.step_with_events(h, &inputs);
+                let p0 = self.x[ix::PA];
+                if exponential && self.exponential_applies(&inputs) {
+                    self.exp_step(h, &inputs);
+                } else {
+                    self.exp.reset();
+                    self.step_with_events(h, &inputs);
+                }
+                self.filter_pressure_sensor(p0, h);
             }
         }
         self.t_s += dt_s;
     }
 
-    /// One RK4 step of length `h` that stops at the switching events inside it (a sliding
-    /// body reaching zero velocity, a stuck body's drive reaching breakaway, the absorber
-    /// running empty), located by regula falsi on the event functions, so that stick–slip
-    /// timing is as accurate as the smooth dynamics instead of O(h).
-    fn step_with_events(&mut self, h: f64, inputs: &Inputs) {
-        let mut remaining = h;
-        for _ in 0..MAX_EVENTS_PER_STEP {
-            let mut g0 = self.event_functions(&self.x, inputs);
-            // A body at rest whose drive already exceeds breakaway (a new run, a step change
-            // of load) is released before the step, not one step late.
-            if g0[..2].iter().any(|g| *g <= 0.0) {
-                self.project(inputs);
-                g0 = self.event_functions(&self.x, inputs);
+    /// Whether the exponential scheme takes the next step: the inverter drives (its bridge
+    /// enabled, or off with the currents died out) and nothing is prescribed.
+    fn exponential_applies(&self, inputs: &Inputs) -> bool {
+        match inputs.drive {
+            Drive::Inverter { enabled, .. } => {
+                inputs.piston.is_none() && (enabled || self.discrete.extinguished)
             }
-            let x0 = self.x;
-            self.rk4(remaining, inputs);
-            let g1 = self.event_functions(&self.x, inputs);
-            // The earliest crossing from positive to non-positive, by linear interpolation.
-            let mut first: Option<(usize, f64)> = None;
-            for k in 0..EVENTS {
-                if g0[k] > 0.0 && g1[k] <= 0.0 {
-                    let f = g0[k] / (g0[k] - g1[k]);
-                    if first.is_none_or(|(_, best)| f < best) {
-                        first = Some((k, f));
-                    }
-                }
-            }
-            let Some((k, f_guess)) = first else {
-                self.project(inputs);
-                return;
-            };
-            // Refine the bracket [lo, hi] with g(lo) > 0 ≥ g(hi); step to hi, where the event
-            // has happened, so the projection sees it.
-            // Illinois variant of regula falsi: an end kept twice has its value halved, so
-            // the bracket shrinks from both sides instead of stagnating.
-            let (mut lo, mut hi) = ((0.0, g0[k]), (1.0, g1[k]));
-            let mut f = f_guess;
-            let mut kept = 0i8;
-            for _ in 0..EVENT_REFINEMENTS {
-                if hi.0 - lo.0 <= EVENT_TOLERANCE {
-                    break;
-                }
-                self.x = x0;
-                self.rk4(f * remaining, inputs);
-                let g = self.event_functions(&self.x, inputs)[k];
-                if g > 0.0 {
-                    lo = (f, g);
-                    kept = if kept > 0 { kept + 1 } else { 1 };
-                    if kept > 1 {
-                        hi.1 *= 0.5;
-                    }
-                } else {
-                    hi = (f, g);
-                    kept = if kept < 0 { kept - 1 } else { -1 };
-                    if kept < -1 {
-                        lo.1 *= 0.5;
-                    }
-                }
-                f = lo.0 + (hi.0 - lo.0) * lo.1 / (lo.1 - hi.1);
-            }
-            self.x = x0;
-            self.rk4(hi.0 * remaining, inputs);
-            self.project(inputs);
-            remaining *= 1.0 - hi.0;
-            if remaining <= 1e-12 * h {
-                return;
-            }
+            _ => false,
         }
-        // More events than expected in one step: finish it plainly.
-        self.rk4(remaining, inputs);
-        self.project(inputs);
     }
 
-    /// Event functions: positive while nothing switches, crossing zero at an event. The
-    /// drive torque and force are evaluated only when a body is stuck (a sliding body's event
-    /// is its velocity), so a step costs four evaluations when nothing switches.
-    fn event_functions(&self, x: &Vector, inputs: &Inputs) -> [f64; EVENTS] {
-        let mut g = [1.0; EVENTS];
-        let shaft =
-            self.shaft_friction.is_active() && !matches!(inputs.drive, Drive::ShaftSpeed { .. });
-        let piston =
-            self.piston_friction.is_active() && inputs.piston.is_none() && !self.cylinder.blocked;
-        let stuck = (shaft && self.discrete.shaft == Slip::Stuck)
-            || (piston && self.discrete.piston == Slip::Stuck);
-        let aux = if stuck {
-            self.derivative(x, inputs).1
-        } else {
-            Aux::default()
-        };
-        let event = |f: &Friction, slip: Slip, velocity: f64, drive: f64| match slip {
-            Slip::Sliding(dir) => velocity * dir,
-            Slip::Stuck => f.breakaway - libm::fabs(drive),
-        };
-        if shaft {
-            g[0] = event(
-                &self.shaft_friction,
-                self.discrete.shaft,
-                x[ix::OMEGA],
-                aux.shaft_drive,
-            );
+    /// The pressure transducer's first-order lag over a step of `h` in which port A's
+    /// pressure went from `p0` to its present value: the exact discrete filter of
+    /// τ·ṗ_s = p − p_s for p linear over the step,
+    /// p_s ← p_1 + (p_s − p_0)·e^{−h/τ} − (p_1 − p_0)·τ/h·(1 − e^{−h/τ}),
+    /// stable and exact for any τ > 0 however short against the step.
+    fn filter_pressure_sensor(&mut self, p0: f64, h: f64) {
+        let tau = self.sensor_lag_s;
+        if tau <= 0.0 {
+            return;
         }
-        if piston {
-            g[1] = event(
-                &self.piston_friction,
-                self.discrete.piston,
-                x[ix::V],
-                aux.piston_drive,
-            );
+        if self.lag_filter.0 != h {
+            let decay = libm::exp(-h / tau);
+            let gain = -tau / h * libm::expm1(-h / tau);
+            self.lag_filter = (h, decay, gain);
         }
-        if self.absorber.enabled {
-            // Scaled so that a full absorber reads 1.
-            g[2] = x[ix::ABS_OIL] / self.absorber.gas.shell_volume_m3;
-        }
-        g
+        let (_, decay, gain) = self.lag_filter;
+        let p1 = self.x[ix::PA];
+        self.x[ix::P_SENSOR] = p1 + (self.x[ix::P_SENSOR] - p0) * decay - (p1 - p0) * gain;
     }
 
     /// Reads every sensor at the present instant (the ADC trigger at the PWM centre).
@@ -797,43 +804,6 @@ impl Plant {
         }
     }
 
-    fn rk4(&mut self, h: f64, inputs: &Inputs) {
-        if self.faulted {
-            self.rk4_with::<true>(h, inputs);
-        } else {
-            self.rk4_with::<false>(h, inputs);
-        }
-    }
-
-    /// [`Plant::rk4`] with the faults' terms (`FAULTED`) or without them compiled in.
-    #[inline(always)]
-    fn rk4_with<const FAULTED: bool>(&mut self, h: f64, inputs: &Inputs) {
-        let x0 = self.x;
-        let a0 = self.angle_terms(x0[ix::THETA]);
-        let stage = |x: &Vector| {
-            let a = self.angle_terms_rotated(&a0, x[ix::THETA]);
-            self.derivative_at::<FAULTED>(x, inputs, &a).0
-        };
-        let k1 = self.derivative_at::<FAULTED>(&x0, inputs, &a0).0;
-        let k2 = stage(&axpy(&x0, 0.5 * h, &k1));
-        let k3 = stage(&axpy(&x0, 0.5 * h, &k2));
-        let k4 = stage(&axpy(&x0, h, &k3));
-        for i in 0..ix::N {
-            self.x[i] = x0[i] + h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
-        }
-        let theta = self.x[ix::THETA];
-        self.rotor = if self.rotor.rotations >= ROTOR_RESYNC_STEPS {
-            RotorPhasor::at(theta)
-        } else {
-            RotorPhasor {
-                theta,
-                phasor: a0.rot_m * Phasor::small(theta - a0.theta),
-                rotations: self.rotor.rotations + 1,
-            }
-        };
-        self.angle = self.angle_terms(theta);
-    }
-
     /// The shaft-angle terms at `theta`: the kept ones when they belong to it, else computed
     /// (from the kept rotor phasor when that belongs to it, else with one `sincos`).
     #[inline]
@@ -891,6 +861,13 @@ impl Plant {
         } else {
             Aux::default()
         };
+        self.project_with(inputs, aux);
+    }
+
+    /// [`Plant::project`] with the drive torque and force `aux` of the present state given
+    /// (only read for a body that may switch).
+    fn project_with(&mut self, inputs: &Inputs, aux: Aux) {
+        let piston_free = inputs.piston.is_none() && !self.cylinder.blocked;
         // Shaft stick/slip (not when the speed is prescribed).
         if !matches!(inputs.drive, Drive::ShaftSpeed { .. }) && self.shaft_friction.is_active() {
             let w = self.x[ix::OMEGA];
@@ -1232,22 +1209,11 @@ impl Plant {
         dx[ix::E_MECH] = p_mech;
         dx[ix::E_HYD] = p_hyd;
 
-        // --- pressure transducer lag
-        if self.sensor_lag_s > 0.0 {
-            dx[ix::P_SENSOR] = (p_a - x[ix::P_SENSOR]) / self.sensor_lag_s;
-        }
+        // The pressure transducer's lag is filtered exactly after each step
+        // ([`Plant::filter_pressure_sensor`]): its derivative stays zero here.
         dx[ix::E_IN] = p_in;
         (dx, aux)
     }
-}
-
-#[inline]
-fn axpy(x: &Vector, a: f64, y: &Vector) -> Vector {
-    let mut out = *x;
-    for (o, v) in out.iter_mut().zip(y) {
-        *o += a * v;
-    }
-    out
 }
 
 fn finite_or(v: f64, default: f64) -> f64 {

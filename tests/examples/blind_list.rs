@@ -1,9 +1,10 @@
 //! Lists what the blind generator draws for a range of seeds, without simulating them: the
-//! hidden effect, the scenario, the columns dropped and the truth (a tool to pick held-out
+//! test, log rate, length, dropped columns and hidden effects (for a freely drawn seed the
+//! first choice, which the generator's observability check may replace). A tool to pick
 //! draws of one kind: `cargo run --release -p tests --example blind_list -- FROM TO`, then
-//! `blind_log` to write the chosen ones).
+//! `blind_log` to write the chosen ones.
 
-use tests::blind::draw;
+use tests::blind::outline;
 
 fn main() {
     let usage = "usage: blind_list FROM TO (seeds FROM..TO)";
@@ -16,14 +17,14 @@ fn main() {
     };
     let (from, to) = (seed(), seed());
     for seed in from..to {
-        let d = draw(seed);
+        let t = outline(seed);
         println!(
-            "{seed} {} {} dropped={:?} {:?} {:?}",
-            d.truth.effect_name,
-            d.truth.scenario,
-            d.structure.dropped,
-            d.truth.parameters,
-            d.structure.controller
+            "{seed} {} {} Hz {:.1} s dropped={:?} hides {}",
+            t.test,
+            t.log_rate_hz,
+            t.duration_s,
+            t.dropped,
+            t.label()
         );
     }
 }

@@ -81,6 +81,7 @@ pub fn health_check(duration_s: f64) -> Scenario {
             None,
             None,
         ],
+        profile: None,
     }
 }
 
@@ -240,6 +241,7 @@ impl Drive {
                 ),
             ],
             compensation: None,
+            integrator: Default::default(),
         };
         Ok(run(&self.plant_at(t), &Rig::nominal(), &scenario, &opt)?.log)
     }

@@ -9,6 +9,7 @@ pub mod blind;
 pub mod campaign;
 pub mod fleet;
 pub mod fuzz;
+pub mod integrator_accuracy;
 
 use closed_loop::{controller_config, ClosedLoop, Sample, Scenario};
 use plant_model::Rig;

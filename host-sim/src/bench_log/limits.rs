@@ -1,7 +1,9 @@
 //! What keeps reading a bench log bounded in memory and its messages readable, whatever the
 //! file holds: a longest line ([`MAX_LINE_BYTES`], enforced below the CSV reader so a file
 //! without line breaks is refused after that many bytes, not after filling the memory), a
-//! most rows ([`MAX_ROWS`]), the physical range of each column ([`physical_range`]), and
+//! most rows and values ([`max_rows`]), a most metadata lines and bytes ([`MAX_METADATA_LINES`],
+//! [`MAX_METADATA_BYTES`]), the physical range of each column ([`physical_range`]), the
+//! shortest interval between two rows a sampler makes ([`MIN_SAMPLE_INTERVAL_S`]), and
 //! excerpts of offending fields instead of the fields whole ([`excerpt`]).
 
 use super::Signal;
@@ -12,8 +14,38 @@ use std::io::{self, Read};
 pub const MAX_LINE_BYTES: usize = 64 * 1024;
 
 /// The most data rows a bench log may have: ten minutes at 10 kHz is 6 million, the
-/// contract's largest typical log; every row costs up to 120 bytes of memory read.
+/// contract's largest typical log; every row costs 8 bytes of memory per column read.
 pub const MAX_ROWS: usize = 10_000_000;
+
+/// The most values a bench log may hold, rows times the contract's columns present: ten
+/// minutes at 10 kHz of all fifteen columns. Read, they take 720 MB, so that reading any
+/// log, or simulating one, stays under 1 GiB of memory.
+pub const MAX_VALUES: usize = 90_000_000;
+
+/// The most data rows of a log with `columns` of the contract's columns: [`MAX_ROWS`], or
+/// fewer so that it holds at most [`MAX_VALUES`] values.
+pub const fn max_rows(columns: usize) -> usize {
+    let by_values = MAX_VALUES / if columns == 0 { 1 } else { columns };
+    if by_values < MAX_ROWS {
+        by_values
+    } else {
+        MAX_ROWS
+    }
+}
+
+/// The most `# key: value` lines a bench log may carry: a logger's header of its
+/// configuration is tens to hundreds of lines; beyond this the lines are data, not a header.
+pub const MAX_METADATA_LINES: usize = 10_000;
+
+/// The most bytes the metadata's keys and values may hold together (each line up to
+/// [`MAX_LINE_BYTES`], but not ten thousand of those). [bytes]
+pub const MAX_METADATA_BYTES: usize = 1 << 20;
+
+/// The shortest interval between two rows: no sampler of an actuator's signals logs faster
+/// than 1 MHz (the drive's telemetry comes at most at its 20 kHz PWM rate, a laboratory
+/// data logger at a few hundred kHz). Shorter steps are a time column in other units than
+/// seconds, or times printed with too few digits for the rate. [s]
+pub const MIN_SAMPLE_INTERVAL_S: f64 = 1e-6;
 
 /// Characters of an offending field quoted in a message.
 const EXCERPT_CHARS: usize = 40;

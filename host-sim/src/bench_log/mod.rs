@@ -13,18 +13,25 @@
 //! [`BenchLog::recorded_at`]); [`read_metadata`] reads the metadata lines alone.
 //!
 //! Beyond the contract, for bounded memory and arithmetic: a line longer than
-//! [`limits::MAX_LINE_BYTES`], more than [`limits::MAX_ROWS`] rows, or a value outside its
-//! column's physical range ([`limits::physical_range`]) is refused the same way.
+//! [`limits::MAX_LINE_BYTES`], more rows than [`limits::max_rows`] allows (at most
+//! [`limits::MAX_ROWS`], and [`limits::MAX_VALUES`] values), more metadata than
+//! [`limits::MAX_METADATA_LINES`] lines or [`limits::MAX_METADATA_BYTES`] bytes, a value
+//! outside its column's physical range ([`limits::physical_range`]), or two rows closer in
+//! time than any sampler logs ([`limits::MIN_SAMPLE_INTERVAL_S`]) is refused the same way.
 //!
-//! The writer checks the same rules first (so every file it writes reads back), writes the
-//! values in shortest round-trip notation and replaces the target atomically
-//! ([`crate::output::atomic`]): a failed write leaves no partial file.
+//! The writer checks the same rules first (so every file it writes reads back) and writes
+//! the values in shortest round-trip notation, as an output of the command's transaction
+//! ([`crate::output::Outputs`]): a failed write leaves no partial file.
 
 pub mod limits;
+mod number;
 pub mod replayable;
 
-use limits::{excerpt, line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_ROWS};
-use std::fmt::Write as _;
+use limits::{
+    excerpt, line_too_long, physical_range, LineLimited, MAX_LINE_BYTES, MAX_METADATA_BYTES,
+    MAX_METADATA_LINES, MAX_ROWS, MAX_VALUES, MIN_SAMPLE_INTERVAL_S,
+};
+
 use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -284,9 +291,14 @@ impl BenchLog {
             column: column.to_string(),
             problem,
         };
+        let mut bytes = 0usize;
         for (i, (k, v)) in self.metadata.iter().enumerate() {
             if !metadata_fits(k, v) {
                 return Err(content(i + 1, k, Problem::BadMetadata));
+            }
+            bytes += k.len() + v.len();
+            if i >= MAX_METADATA_LINES || bytes > MAX_METADATA_BYTES {
+                return Err(content(i + 1, k, Problem::TooMuchMetadata));
             }
         }
         let header_line = self.metadata.len() + 1;
@@ -315,22 +327,17 @@ impl BenchLog {
                 return Err(content(header_line + 1 + i, s.name(), beyond(s, c[i])));
             }
         }
-        if rows > MAX_ROWS {
+        let most = limits::max_rows(self.columns().count());
+        if rows > most {
             return Err(content(
-                header_line + 1 + MAX_ROWS,
+                header_line + 1 + most,
                 Signal::Time.name(),
-                Problem::TooManyRows,
+                Problem::TooManyRows { most },
             ));
         }
-        if let Some(i) = self.t_s.windows(2).position(|w| w[1] <= w[0]) {
-            return Err(content(
-                header_line + 2 + i,
-                Signal::Time.name(),
-                Problem::TimeNotIncreasing {
-                    previous: self.t_s[i],
-                    value: self.t_s[i + 1],
-                },
-            ));
+        let mut steps = self.t_s.windows(2).enumerate();
+        if let Some((i, problem)) = steps.find_map(|(i, w)| Some((i, time_problem(w[0], w[1])?))) {
+            return Err(content(header_line + 2 + i, Signal::Time.name(), problem));
         }
         if rows < MIN_ROWS {
             return Err(content(
@@ -382,8 +389,14 @@ pub enum Problem {
         unit: &'static str,
     },
     /// More rows than a bench log may have.
-    #[error("more than {MAX_ROWS} data rows; split the log")]
-    TooManyRows,
+    #[error(
+        "more than {most} data rows; a bench log holds at most {MAX_ROWS} rows and \
+         {MAX_VALUES} values of the contract's columns: split the log"
+    )]
+    TooManyRows {
+        /// The most rows a log of these columns may have.
+        most: usize,
+    },
     /// A line longer than a bench log's longest.
     #[error("line longer than {MAX_LINE_BYTES} bytes (not a bench log, or a binary file?)")]
     LineTooLong,
@@ -398,6 +411,25 @@ pub enum Problem {
         /// This row's time. [s]
         value: f64,
     },
+    /// Two rows closer in time than any sampler logs.
+    #[error(
+        "time {value} s follows the previous row's {previous} s by {:.3e} s; no sampler logs \
+         rows less than {MIN_SAMPLE_INTERVAL_S:e} s apart (is t_s in seconds, printed with \
+         enough digits?)",
+        value - previous
+    )]
+    IntervalTooShort {
+        /// The previous row's time. [s]
+        previous: f64,
+        /// This row's time. [s]
+        value: f64,
+    },
+    /// More metadata than a bench log's header holds.
+    #[error(
+        "more than {MAX_METADATA_LINES} metadata lines or {MAX_METADATA_BYTES} bytes of \
+         metadata; a bench log's `# key: value` lines are a short header"
+    )]
+    TooMuchMetadata,
     /// The log is too short.
     #[error("only {rows} data rows; a bench log needs at least {MIN_ROWS}")]
     TooFewRows {
@@ -582,6 +614,7 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     for &(_, s) in &known {
         log.column_mut(s);
     }
+    let most_rows = limits::max_rows(known.len());
 
     let mut last_line = header_line;
     while reader
@@ -590,8 +623,9 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     {
         let line = line_of(&record, last_line + 1);
         last_line = line;
-        if log.len() == MAX_ROWS {
-            return Err(err(line, Signal::Time.name(), Problem::TooManyRows));
+        if log.len() == most_rows {
+            let problem = Problem::TooManyRows { most: most_rows };
+            return Err(err(line, Signal::Time.name(), problem));
         }
         if record.len() != names.len() {
             let column = names
@@ -627,14 +661,8 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
                 return Err(err(line, s.name(), beyond(s, v)));
             }
             if s == Signal::Time {
-                if let Some(&previous) = log.t_s.last() {
-                    if v <= previous {
-                        return Err(err(
-                            line,
-                            s.name(),
-                            Problem::TimeNotIncreasing { previous, value: v },
-                        ));
-                    }
+                if let Some(problem) = log.t_s.last().and_then(|p| time_problem(*p, v)) {
+                    return Err(err(line, s.name(), problem));
                 }
             }
             log.column_mut(s).push(v);
@@ -668,6 +696,7 @@ fn parse_metadata<R: BufRead>(
         source,
     };
     let mut consumed = 0usize;
+    let mut metadata_bytes = 0usize;
     let mut line = String::new();
     loop {
         let buf = input.fill_buf().map_err(io_err)?;
@@ -699,6 +728,10 @@ fn parse_metadata<R: BufRead>(
             // the value) is refused here too, so every log read can be written.
             if !metadata_fits(k, v) {
                 return Err(err(consumed, k, Problem::BadMetadata));
+            }
+            metadata_bytes += k.len() + v.len();
+            if metadata.len() == MAX_METADATA_LINES || metadata_bytes > MAX_METADATA_BYTES {
+                return Err(err(consumed, k, Problem::TooMuchMetadata));
             }
             metadata.push((k.to_string(), v.to_string()));
         }
@@ -732,6 +765,18 @@ fn metadata_fits(k: &str, v: &str) -> bool {
         && !v.contains(['\n', '\r'])
 }
 
+/// What is wrong with a row at `value` [s] after one at `previous` [s]: time going back or
+/// standing, or a step shorter than any sampler makes.
+pub fn time_problem(previous: f64, value: f64) -> Option<Problem> {
+    if value <= previous {
+        Some(Problem::TimeNotIncreasing { previous, value })
+    } else if value - previous < MIN_SAMPLE_INTERVAL_S {
+        Some(Problem::IntervalTooShort { previous, value })
+    } else {
+        None
+    }
+}
+
 /// Whether `v` lies outside the physical range of `signal`'s column.
 fn out_of_range(signal: Signal, v: f64) -> bool {
     let (low, high, _) = physical_range(signal);
@@ -749,16 +794,44 @@ fn beyond(signal: Signal, value: f64) -> Problem {
     }
 }
 
-/// Writes `log` to `path` atomically, after [`BenchLog::check`]: metadata lines, the header
-/// of the columns present, one row per sample in shortest round-trip notation.
+/// Writes `log` to `path` as a command's one output ([`crate::output::Outputs`]), after
+/// [`BenchLog::check`]: metadata lines, the header of the columns present, one row per
+/// sample in shortest round-trip notation.
 pub fn write(path: &Path, log: &BenchLog) -> Result<(), BenchLogError> {
+    let mut out = crate::output::Outputs::new();
+    stage(&mut out, "", path, log)
+        .and_then(|()| out.commit())
+        .map_err(|e| match e {
+            crate::output::CliError::BenchLog(e) => e,
+            crate::output::CliError::Write { file, source } => {
+                BenchLogError::Write { file, source }
+            }
+            e => BenchLogError::Write {
+                file: path.to_path_buf(),
+                source: io::Error::other(e.to_string()),
+            },
+        })
+}
+
+/// Stages `log` (checked first) as the output file `path` given by `flag`.
+pub fn stage(
+    out: &mut crate::output::Outputs,
+    flag: &str,
+    path: &Path,
+    log: &BenchLog,
+) -> Result<(), crate::output::CliError> {
     log.check(path)?;
-    crate::output::atomic::write_with(path, |w| write_to(w, log)).map_err(|source| {
-        BenchLogError::Write {
-            file: path.to_path_buf(),
-            source,
-        }
-    })
+    out.file_with(flag, path, |w| write_to(w, log))
+}
+
+/// Writes `log` (checked first) as the file `name` of a staged output folder.
+pub fn write_into(
+    d: &crate::output::StagedFolder,
+    name: &str,
+    log: &BenchLog,
+) -> Result<(), crate::output::CliError> {
+    log.check(&d.shown(name))?;
+    d.file_with(name, |w| write_to(w, log))
 }
 
 /// `log` as the bytes [`write`] puts in a file, after the same checks.
@@ -775,37 +848,40 @@ pub fn to_bytes(log: &BenchLog) -> Result<Vec<u8>, BenchLogError> {
 /// What errors about a log held in memory name as its file.
 const IN_MEMORY: &str = "<in memory>";
 
-/// Writes `log` (assumed checked) to `w`.
+/// Writes `log` (assumed checked) to `w`: the metadata lines, the header, the rows. Names
+/// and numbers never need CSV quoting, so the rows are spelled directly, a block of them
+/// at a time.
 fn write_to(w: &mut dyn Write, log: &BenchLog) -> io::Result<()> {
     for (k, v) in &log.metadata {
         writeln!(w, "# {k}: {v}")?;
     }
     let columns: Vec<(Signal, &[f64])> = log.columns().collect();
-    let mut csv = csv::WriterBuilder::new().from_writer(w);
-    csv.write_record(columns.iter().map(|(s, _)| s.name()))?;
-    let mut field = String::with_capacity(32);
+    let names: Vec<&str> = columns.iter().map(|(s, _)| s.name()).collect();
+    writeln!(w, "{}", names.join(","))?;
+    let mut block: Vec<u8> = Vec::with_capacity(1 << 16);
     for row in 0..log.len() {
-        for (_, c) in &columns {
-            field.clear();
-            format_value(&mut field, c.get(row).copied().unwrap_or(f64::NAN));
-            csv.write_field(&field)?;
+        for (k, (_, c)) in columns.iter().enumerate() {
+            if k > 0 {
+                block.push(b',');
+            }
+            number::push_bytes(&mut block, c.get(row).copied().unwrap_or(f64::NAN));
         }
-        csv.write_record(None::<&[u8]>)?;
+        block.push(b'\n');
+        if block.len() >= 1 << 15 {
+            w.write_all(&block)?;
+            block.clear();
+        }
     }
-    csv.flush()
+    w.write_all(&block)?;
+    w.flush()
 }
 
-/// Shortest round-trip text of `v`: Rust's float formatting prints the fewest digits that
-/// parse back to the same f64; positional for ordinary magnitudes, exponent notation for
-/// very small or large ones (where positional would spell out dozens of zeros).
+/// Shortest round-trip text of `v`: the fewest digits that parse back to the same f64;
+/// positional for ordinary magnitudes, exponent notation for very small or large ones
+/// (where positional would spell out dozens of zeros) — Rust's float formatting, spelled
+/// faster ([`number`]).
 pub fn format_value(out: &mut String, v: f64) {
-    let a = v.abs();
-    // `write!` into a String cannot fail.
-    let _ = if a == 0.0 || (1e-5..1e16).contains(&a) {
-        write!(out, "{v}")
-    } else {
-        write!(out, "{v:e}")
-    };
+    number::push(out, v);
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 //! periodic effects (tens of cycles per revolution) only from densely sampled data.
 //!
 //! - the span is at most [`MAX_SPAN_S`], the contract's longest typical log;
+//! - the rows are at most [`MAX_REPLAYED_ROWS`], for bounded memory;
 //! - the median sampling interval is at most [`MAX_MEDIAN_INTERVAL_S`];
 //! - no interval exceeds [`GAP_FACTOR`] medians and [`MIN_GAP_S`] (a gap in the record:
 //!   the replay would run blind through it and meet the log again somewhere else);
@@ -19,6 +20,12 @@ use std::path::Path;
 
 /// Longest time span replayed: the contract's largest typical bench log. [s]
 pub const MAX_SPAN_S: f64 = 600.0;
+
+/// Most rows replayed: the diagnosis keeps every row's measured, simulated and residual
+/// traces (some hundreds of bytes a row; `docs/memory.md` has the measured figures), so
+/// that it stays under 1 GiB of memory; the whole [`MAX_SPAN_S`] at 3.3 kHz, or 200 s at
+/// 10 kHz.
+pub const MAX_REPLAYED_ROWS: usize = 2_000_000;
 
 /// Longest median sampling interval (100 Hz): below it the pulsation orders of a pump
 /// turning a few revolutions per second alias. [s]
@@ -56,6 +63,18 @@ pub fn check(log: &BenchLog, rig: &Rig, file: &Path) -> Result<(), BenchLogError
             format!(
                 "the log spans {span:.1} s; the diagnosis replays at most {MAX_SPAN_S} s (its \
                  time grows with the span): cut the log to the part to explain"
+            ),
+        ));
+    }
+    if n > MAX_REPLAYED_ROWS {
+        return Err(at(
+            MAX_REPLAYED_ROWS,
+            "t_s",
+            format!(
+                "the log has {n} rows; the diagnosis replays at most {MAX_REPLAYED_ROWS} (it \
+                 keeps every row's traces, within 1 GiB of memory): cut the log to the part \
+                 to explain, or log at a lower rate ({:.0} Hz holds the {MAX_SPAN_S} s)",
+                MAX_REPLAYED_ROWS as f64 / MAX_SPAN_S
             ),
         ));
     }
@@ -119,4 +138,37 @@ pub fn check(log: &BenchLog, rig: &Rig, file: &Path) -> Result<(), BenchLogError
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A log of `n` rows at 10 kHz, every signal varying.
+    fn log_of(n: usize) -> BenchLog {
+        let ramp: Vec<f64> = (0..n).map(|k| (k % 1000) as f64).collect();
+        BenchLog {
+            t_s: (0..n).map(|k| k as f64 * 1e-4).collect(),
+            p_ref_pa: vec![5e6; n],
+            p_pa: ramp.iter().map(|r| 5e6 + r).collect(),
+            speed_rad_s: ramp.iter().map(|r| r * 1e-3).collect(),
+            iq_a: ramp.iter().map(|r| r * 1e-3).collect(),
+            id_a: vec![0.0; n],
+            ..BenchLog::default()
+        }
+    }
+
+    #[test]
+    fn a_log_beyond_the_replayed_rows_is_refused_naming_the_bound() {
+        let rig = Rig::nominal();
+        let file = Path::new("long.csv");
+        // 200 s at 10 kHz is within the span; one row more than the bound is refused.
+        let e = check(&log_of(MAX_REPLAYED_ROWS + 1), &rig, file).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("2000001 rows") && text.contains("at most 2000000"),
+            "{text}"
+        );
+        check(&log_of(MAX_REPLAYED_ROWS), &rig, file).unwrap();
+    }
 }

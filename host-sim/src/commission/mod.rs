@@ -8,7 +8,7 @@
 pub mod margins;
 
 use crate::output::paths::Declared;
-use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::output::{is_stdout, CliError, Outputs};
 use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::commissioning::{commission, nameplate_config};
@@ -300,11 +300,12 @@ pub fn run_commission(rig: &Rig, args: &CommissionArgs) -> Result<(), CliError> 
         1.0 / config.rates.pwm_hz as f64,
         1.0 / config.rates.speed_loop_hz as f64,
     );
+    let mut out = Outputs::new();
     if let Some(path) = &args.json {
-        write_json(path, &report.to_json())?;
-        if is_stdout(path) {
-            return Ok(());
-        }
+        out.json("--json", path, &report.to_json())?;
     }
-    print_stdout(&report.to_table())
+    if !args.json.as_deref().is_some_and(is_stdout) {
+        out.print(&report.to_table());
+    }
+    out.commit()
 }

@@ -20,11 +20,12 @@
 //! | 0      | 4    | magic `0x5043_4845` (bytes `E H C P`)              |
 //! | 4      | 2    | format version ([`TRAILER_VERSION`])               |
 //! | 6      | 2    | number N of parameters                              |
-//! | 8      | 8·N  | per parameter: wire id (u8), 3 bytes 0, value (f32) |
+//! | 8      | 8·N  | per parameter: wire id (u32), value (f32)           |
 //! | 8+8N   | 4    | CRC-32 (ISO-HDLC) of bytes 0‥8+8N                  |
 //!
-//! Only the modulation's parameters ([`FLOW_IDS`]) may appear, each once, each within its
-//! bounds. A file without a trailer is a table alone (the modulation off), as before.
+//! The id field is read whole: the drive's wire ids fit in its low byte, and an id beyond
+//! them (320 is not 64) is an unknown parameter, named as written. Only the modulation's
+//! parameters ([`FLOW_IDS`]) may appear, each once, each within its bounds. A file without a trailer is a table alone (the modulation off), as before.
 
 use firmware::compensation::record::CRC;
 use firmware::parameters::ParamId;
@@ -134,7 +135,7 @@ impl FlowParams {
         b.extend_from_slice(&TRAILER_VERSION.to_le_bytes());
         b.extend_from_slice(&(p.len() as u16).to_le_bytes());
         for (id, v) in p {
-            b.extend_from_slice(&[id.code(), 0, 0, 0]);
+            b.extend_from_slice(&u32::from(id.code()).to_le_bytes());
             b.extend_from_slice(&v.to_le_bytes());
         }
         let crc = CRC.checksum(&b);
@@ -175,8 +176,11 @@ impl FlowParams {
         let mut values: [Option<f32>; 4] = [None; 4];
         for k in 0..n {
             let at = 8 + 8 * k;
-            let id = ParamId::from_code(b[at])
-                .ok_or_else(|| format!("parameter trailer: unknown parameter id {}", b[at]))?;
+            let code = u32_at(at);
+            let id = u8::try_from(code)
+                .ok()
+                .and_then(ParamId::from_code)
+                .ok_or_else(|| format!("parameter trailer: unknown parameter id {code}"))?;
             let slot = FLOW_IDS
                 .iter()
                 .position(|f| *f == id)

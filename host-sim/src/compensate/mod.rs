@@ -30,7 +30,7 @@ pub mod table;
 
 use crate::bench_log::{self, BenchLog};
 use crate::output::paths::Declared;
-use crate::output::{print_stdout, write_json, CliError};
+use crate::output::{CliError, Outputs};
 use clap::{Args, ValueEnum};
 use firmware::can_protocol::{Frame, NodeId};
 use firmware::compensation::record::{self, RECORD_LEN};
@@ -122,13 +122,28 @@ pub fn find(logs: &[BenchLog], rig: &Rig) -> Result<Found, CliError> {
     })
 }
 
+/// Most rows learned from, over all the logs: the learning diagnoses each log and keeps
+/// every row's traces of all of them at once (more bytes a row than one diagnosis;
+/// `docs/memory.md`), so that it stays under 1 GiB of memory.
+pub const MAX_LEARNED_ROWS: usize = 1_500_000;
+
 /// Reads and checks the logs (bad input before any work).
 fn read_logs(rig: &Rig, args: &CompensateArgs) -> Result<Vec<BenchLog>, CliError> {
+    let mut rows = 0;
     args.logs
         .iter()
         .map(|path| {
             let log = bench_log::read(path)?;
             bench_log::replayable::check(&log, rig, path)?;
+            rows += log.len();
+            if rows > MAX_LEARNED_ROWS {
+                return Err(CliError::BadInput(format!(
+                    "bench log `{}` brings the logs to {rows} rows; eha compensate learns from \
+                     at most {MAX_LEARNED_ROWS} in all (it keeps every row's traces, within \
+                     1 GiB of memory): give fewer or shorter logs, or log at a lower rate",
+                    path.display()
+                )));
+            }
             if log.theta_m_rad.is_none() {
                 return Err(CliError::BadInput(format!(
                     "bench log `{}` has no theta_m_rad column: an angle-indexed table needs \
@@ -359,16 +374,12 @@ fn learn_and_predict(
     learned
 }
 
-/// Writes the table file (`bytes`) to `path` atomically.
-fn write_table_file(path: &std::path::Path, bytes: &[u8]) -> Result<(), CliError> {
-    crate::output::atomic::write(path, bytes).map_err(|source| CliError::Write {
-        file: path.to_path_buf(),
-        source,
-    })
-}
-
-/// Writes `frames` to `path` as a `candump -l` log.
-fn write_can_log(path: &std::path::Path, frames: &[Frame]) -> Result<(), CliError> {
+/// Stages `frames` as the `candump -l` log `--can-log path`.
+fn stage_can_log(
+    out: &mut Outputs,
+    path: &std::path::Path,
+    frames: &[Frame],
+) -> Result<(), CliError> {
     let commands: Vec<crate::can_commands::CanCommand> = frames
         .iter()
         .map(|f| crate::can_commands::CanCommand {
@@ -376,18 +387,19 @@ fn write_can_log(path: &std::path::Path, frames: &[Frame]) -> Result<(), CliErro
             what: "compensation table".into(),
         })
         .collect();
-    crate::can_commands::write_candump_log(path, &commands)
+    crate::can_commands::stage_candump_log(out, path, &commands)
 }
 
-/// `eha compensate`: checks the arguments and logs, learns the feed-forward, writes the
-/// table, prints the summary and the CAN frames, then writes the CAN log and the JSON if
-/// asked for.
+/// `eha compensate`: checks the arguments and logs, learns the feed-forward, then writes
+/// the table, the CAN log and the JSON if asked for, together, and prints the summary and
+/// the CAN frames.
 pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> {
     check_exclude(&args.exclude)?;
     let logs = read_logs(rig, args)?;
     let outcome = learn_and_predict(rig, &logs, args)?;
     let bytes = outcome.ff.file_bytes();
-    write_table_file(&args.out, &bytes)?;
+    let mut out = Outputs::new();
+    out.file("--out", &args.out, &bytes)?;
     let node = NodeId::new(crate::tune::can::NODE)
         .map_err(|e| CliError::Failed(format!("CAN node: {e:?}")))?;
     let frames = can::frames(&outcome.ff, node);
@@ -397,18 +409,19 @@ pub fn run_compensate(rig: &Rig, args: &CompensateArgs) -> Result<(), CliError> 
         node,
         frames: &frames,
     };
-    print_stdout(&summary::text(
+    // Standard output: the summary, then the JSON when it goes there too (`--json -`).
+    out.print(&summary::text(
         args,
         logs.len(),
         &outcome,
         &in_table,
         &written,
-    ))?;
+    ));
     if let Some(path) = &args.can_log {
-        write_can_log(path, &frames)?;
+        stage_can_log(&mut out, path, &frames)?;
     }
     if let Some(path) = &args.json {
-        write_json(path, &summary::json(args, &outcome, &in_table))?;
+        out.json("--json", path, &summary::json(args, &outcome, &in_table))?;
     }
-    Ok(())
+    out.commit()
 }

@@ -179,6 +179,7 @@ pub fn holding(
             progress: false,
             metadata: Vec::new(),
             compensation: ff.cloned(),
+            integrator: Default::default(),
         },
     )
     .map_err(CliError::Failed)?;

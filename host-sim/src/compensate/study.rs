@@ -47,6 +47,7 @@ pub const FOREIGN_STYLE: Scenario = Scenario {
         None,
         None,
     ],
+    profile: None,
 };
 
 /// Length of the learning hold at 5 MPa. [s]
@@ -103,6 +104,7 @@ fn learning_log(
             progress: false,
             metadata: vec![("source".into(), "compensation study".into())],
             compensation: None,
+            integrator: Default::default(),
         },
     )
     .map_err(CliError::Failed)?;

@@ -19,6 +19,7 @@ use super::calibration::{
     MechanicalRelation, Patient, Release, HYDRAULIC_WINDOW_S, MAX_FIT_S,
 };
 use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
+use super::contributions::{contributions, Contributions};
 use super::cylinder::{self, CylinderRelation};
 use super::diagnosis::Diagnosis;
 use super::electrical::ElectricalRelation;
@@ -62,6 +63,8 @@ pub struct Analysis {
     pub candidate_orders: Vec<(u32, &'static str)>,
     /// Every tested effect, most likely first.
     pub tested: Vec<Tested>,
+    /// Fit points each named effect gains per signal as it joins the model in rank order.
+    pub contributions: Contributions,
 }
 
 /// Diagnoses `log` against the rig file `rig`.
@@ -411,8 +414,19 @@ pub fn analyse_reporting(
     } else {
         predict(&ctx, &ext_values)
     };
+    let contributions = contributions(
+        &ctx,
+        log,
+        &facts,
+        rig,
+        shaft,
+        (&tested, &named),
+        &base_values,
+        (&baseline, &extended),
+    );
     progress.step("evidence");
-    let a = assemble(log, &facts, &rel, &cal, tested, named, baseline, extended);
+    let mut a = assemble(log, &facts, &rel, &cal, tested, named, baseline, extended);
+    a.contributions = contributions;
     progress.step("done");
     Ok(a)
 }

@@ -378,6 +378,7 @@ mod tests {
                 p: Complex64::default(),
                 torque: Complex64::default(),
                 voltages: Some([z[3], z[4]]),
+                dead_time_voltages: Vec::new(),
             })
             .collect();
         let w = WindowLines {

@@ -170,6 +170,9 @@ impl<R: Relation> Relation for Patient<'_, R> {
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
     }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
+    }
 }
 
 /// A relation with parameter `index` held at `value`: the best fit of the others there
@@ -204,6 +207,9 @@ impl<R: Relation> Relation for Pinned<'_, R> {
     }
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
+    }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
     }
 }
 
@@ -240,6 +246,9 @@ impl<R: Relation> Relation for Freed<'_, R> {
     }
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
+    }
+    fn correlation_bin(&self) -> usize {
+        self.relation.correlation_bin()
     }
 }
 

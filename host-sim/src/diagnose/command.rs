@@ -4,7 +4,7 @@
 use super::analysis::{analyse_reporting, Precision, STEPS};
 use super::DiagnoseError;
 use crate::output::paths::Declared;
-use crate::output::{print_stdout, write_json, CliError};
+use crate::output::{CliError, Outputs};
 use clap::Args;
 use plant_model::Rig;
 use std::path::PathBuf;
@@ -29,7 +29,7 @@ impl DiagnoseArgs {
         Declared::default()
             .input("LOG", Some(&self.log))
             .file("--json", self.json.as_ref())
-            .dir("--report", self.report.as_ref())
+            .dir("--report", self.report.as_ref(), super::report::FILES)
     }
 }
 
@@ -112,13 +112,16 @@ pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
             e.unwrap_or(f64::NAN)
         ));
     }
-    print_stdout(&text)?;
+    let mut out = Outputs::new();
+    out.print(&text);
     if let Some(dir) = &args.report {
-        super::report::write_report(dir, &args.log, &analysis)?;
+        out.folder("--report", dir, super::report::FILES, |folder| {
+            super::report::write_report(folder, &args.log, &analysis)
+        })?;
     }
     if let Some(path) = &args.json {
         let value = serde_json::to_value(d).map_err(|e| CliError::Failed(e.to_string()))?;
-        write_json(path, &value)?;
+        out.json("--json", path, &value)?;
     }
-    Ok(())
+    out.commit()
 }

@@ -108,6 +108,7 @@ impl<'a> ElectricalRelation<'a> {
                 0.0
             }
         };
+        let base = rows.start;
         for k in rows {
             let (i_d, i_q) = (log.id_a[k], log.iq_a[k]);
             let w_e = pp * log.speed_rad_s[k];
@@ -122,8 +123,8 @@ impl<'a> ElectricalRelation<'a> {
                 u_d -= loss_d;
                 u_q -= loss_q;
             }
-            ud[k] = u_d;
-            uq[k] = u_q;
+            ud[k - base] = u_d;
+            uq[k - base] = u_q;
         }
     }
 }
@@ -163,14 +164,13 @@ impl Relation for ElectricalRelation<'_> {
         };
         let sd = self.facts.noise(Signal::Ud).unwrap_or(1.0).max(1e-3);
         let sq = self.facts.noise(Signal::Uq).unwrap_or(1.0).max(1e-3);
-        let n = self.log.len();
-        let (mut ud, mut uq) = (vec![0.0; n], vec![0.0; n]);
         let mut out = Vec::new();
         for r in rows {
+            let (mut ud, mut uq) = (vec![0.0; r.len()], vec![0.0; r.len()]);
             self.predict(values, r.clone(), &mut ud, &mut uq);
-            for k in r.clone() {
-                out.push(huber((ud_log[k] - ud[k]) / sd));
-                out.push(huber((uq_log[k] - uq[k]) / sq));
+            for (i, k) in r.clone().enumerate() {
+                out.push(huber((ud_log[k] - ud[i]) / sd));
+                out.push(huber((uq_log[k] - uq[i]) / sq));
             }
         }
         out

@@ -136,6 +136,23 @@ pub struct HydraulicInputs<'a> {
     pub start_rows: usize,
     /// The fill level the port's check valve holds it above, as the transducer reads it. [Pa]
     pub fill_pa: f64,
+    /// Rows between the predicted ones: a fast log is integrated in steps of about
+    /// [`FIT_STEP_S`] when fitted (1 when every row is predicted).
+    pub stride: usize,
+}
+
+/// Time between the rows a fit predicts: a 10 kHz log is integrated in the steps a 1 kHz
+/// log is (each still cut into substeps of at most [`MAX_SUBSTEP_S`]), so the fits cost
+/// what they cost on a 1 kHz log of the same length. [s]
+pub const FIT_STEP_S: f64 = 1e-3;
+
+/// The rows of `rows` a window with `stride` predicts: every `stride`-th from the first,
+/// and the last.
+pub fn strided(rows: Range<usize>, stride: usize) -> impl Iterator<Item = usize> {
+    let last = rows.end.saturating_sub(1);
+    (rows.start..rows.end)
+        .step_by(stride.max(1))
+        .chain((last > rows.start && (last - rows.start) % stride.max(1) != 0).then_some(last))
 }
 
 impl<'a> HydraulicInputs<'a> {
@@ -156,6 +173,15 @@ impl<'a> HydraulicInputs<'a> {
             } else {
                 f64::NEG_INFINITY
             },
+            stride: 1,
+        }
+    }
+
+    /// The same inputs, predicted every [`FIT_STEP_S`] (as a fit reads them).
+    pub fn for_fit(self, period_s: f64) -> HydraulicInputs<'a> {
+        HydraulicInputs {
+            stride: rows_spanning(FIT_STEP_S, period_s, 1),
+            ..self
         }
     }
 }
@@ -228,11 +254,13 @@ impl Hydraulics {
     /// windows' rows (the other rows untouched).
     pub fn predict(&self, inputs: &HydraulicInputs<'_>, windows: &[Range<usize>], out: &mut [f64]) {
         for w in windows {
-            self.predict_window(inputs, w.clone(), out);
+            self.predict_window(inputs, w.clone(), &mut out[w.clone()]);
         }
     }
 
-    fn predict_window(&self, x: &HydraulicInputs<'_>, rows: Range<usize>, out: &mut [f64]) {
+    /// Predicts the measured pressure over the window `rows` into `out`, row `rows.start + i`
+    /// at index i.
+    pub fn predict_window(&self, x: &HydraulicInputs<'_>, rows: Range<usize>, out: &mut [f64]) {
         let hp = &self.params;
         let head = rows.start..(rows.start + x.start_rows).min(rows.end);
         let (s0, slope) = line_start(&x.t_s[head.clone()], &x.p_pa[head]);
@@ -254,14 +282,16 @@ impl Hydraulics {
             [&mut a, &mut b],
         );
         let (mut num, mut den) = (0.0, 0.0);
-        for i in 1..n {
+        for k in strided(rows.clone(), x.stride).skip(1) {
+            let i = k - rows.start;
             let g = (b[i] - a[i]) / delta;
-            num += g * (x.p_pa[rows.start + i] - a[i]);
+            num += g * (x.p_pa[k] - a[i]);
             den += g * g;
         }
         let shift = if den > 0.0 { num / den } else { 0.0 };
-        for i in 0..n {
-            out[rows.start + i] = a[i] + shift * (b[i] - a[i]) / delta;
+        for k in strided(rows.clone(), x.stride) {
+            let i = k - rows.start;
+            out[i] = a[i] + shift * (b[i] - a[i]) / delta;
         }
     }
 
@@ -292,8 +322,10 @@ impl Hydraulics {
         let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
         // The transducer's step factor 1 − e^(−h/τ), recomputed only when h changes.
         let mut lag = (f64::NAN, 1.0);
-        for k in rows.start..rows.end - 1 {
-            let dt = x.t_s[k + 1] - x.t_s[k];
+        let steps_at: Vec<usize> = strided(rows.clone(), x.stride).collect();
+        for pair in steps_at.windows(2) {
+            let (k, next) = (pair[0], pair[1]);
+            let dt = x.t_s[next] - x.t_s[k];
             let steps = ((dt / MAX_SUBSTEP_S).ceil() as usize).max(1);
             let h = dt / steps as f64;
             if h != lag.0 {
@@ -304,9 +336,9 @@ impl Hydraulics {
                 };
                 lag = (h, f);
             }
-            let dtheta = x.theta_rad[k + 1] - x.theta_rad[k];
+            let dtheta = x.theta_rad[next] - x.theta_rad[k];
             let (x0, dx) = match x.x_m {
-                Some(xm) => (xm[k], xm[k + 1] - xm[k]),
+                Some(xm) => (xm[k], xm[next] - xm[k]),
                 None => (0.0, 0.0),
             };
             let p_low = x.p_low_pa[k];
@@ -326,7 +358,7 @@ impl Hydraulics {
                 }
             }
             for (o, st) in out.iter_mut().zip(&st) {
-                o[k + 1 - rows.start] = gain * st.s + hp.sensor_offset_pa;
+                o[next - rows.start] = gain * st.s + hp.sensor_offset_pa;
             }
         }
     }
@@ -413,6 +445,7 @@ mod tests {
             p_pa: &p,
             start_rows: 10,
             fill_pa: 0.0,
+            stride: 1,
         };
         let mut out = vec![0.0; n];
         Hydraulics::new(hp.clone(), &Rig::nominal()).simulate_window(

@@ -18,7 +18,7 @@
 
 use crate::bench_log::BenchLog;
 use crate::diagnose::facts::{LogFacts, SteadyWindow};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
@@ -162,10 +162,16 @@ fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
 /// whose torque weighs the angle's line with J·(k·ω̄)².
 const TREND_TERMS: usize = 4;
 
-/// Complex amplitudes of `signals` at `orders` over `rows` (each signal a slice whose first
-/// element is the log's row given beside it), by one least-squares fit of a
-/// cubic in time ([`TREND_TERMS`]) and sin/cos of k·θ for every order (the orders are near-orthogonal over
-/// whole revolutions; fitting them together removes what leaks between them).
+/// Complex amplitudes of `signals` at `orders` (ascending) over `rows` (each signal a slice
+/// whose first element is the log's row given beside it), by one least-squares fit of a
+/// cubic in time ([`TREND_TERMS`]) and sin/cos of k·θ for every order (the orders are
+/// near-orthogonal over whole revolutions; fitting them together removes what leaks
+/// between them).
+///
+/// The fit is solved through its normal equations, accumulated in one pass over the rows:
+/// the columns are Legendre polynomials and whole-revolution sinusoids, well conditioned,
+/// and the pass costs n·c²/2 against the n·c² several times over of a decomposition of
+/// the n×c design matrix. Each row's sinusoids are powers of one e^{jθ}, not a sine each.
 fn lock_in(
     t: &[f64],
     theta: &[f64],
@@ -180,42 +186,55 @@ fn lock_in(
     }
     let t0 = t[rows.start];
     let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
-    let a = DMatrix::from_fn(n, cols, |i, j| {
-        let k = rows.start + i;
-        if j < TREND_TERMS {
-            // Legendre polynomials of the window's time on [−1, 1]: well conditioned.
-            let x = 2.0 * (t[k] - t0) / span - 1.0;
-            return match j {
-                0 => 1.0,
-                1 => x,
-                2 => 1.5 * x * x - 0.5,
-                _ => 2.5 * x * x * x - 1.5 * x,
-            };
+    let mut gram = DMatrix::<f64>::zeros(cols, cols);
+    let mut rhs = DMatrix::<f64>::zeros(cols, signals.len());
+    let mut phi = vec![0.0; cols];
+    for k in rows.clone() {
+        // Legendre polynomials of the window's time on [−1, 1]: well conditioned.
+        let x = 2.0 * (t[k] - t0) / span - 1.0;
+        phi[..TREND_TERMS].copy_from_slice(&[1.0, x, 1.5 * x * x - 0.5, 2.5 * x * x * x - 1.5 * x]);
+        let (s1, c1) = theta[k].sin_cos();
+        let base = Complex64::new(c1, s1);
+        let mut z = Complex64::new(1.0, 0.0);
+        let mut last = 0;
+        for (m, &order) in orders.iter().enumerate() {
+            z *= base.powu(order - last);
+            last = order;
+            phi[TREND_TERMS + 2 * m] = z.re;
+            phi[TREND_TERMS + 2 * m + 1] = z.im;
         }
-        let order = orders[(j - TREND_TERMS) / 2] as f64;
-        let x = order * theta[k];
-        if (j - TREND_TERMS) % 2 == 0 {
-            x.cos()
-        } else {
-            x.sin()
+        for i in 0..cols {
+            let pi = phi[i];
+            for j in i..cols {
+                gram[(i, j)] += pi * phi[j];
+            }
         }
-    });
-    let svd = a.svd(true, true);
-    signals
-        .iter()
-        .map(|(y, offset)| {
-            let b = DVector::from_iterator(
-                n,
-                y[rows.start - offset..rows.end - offset].iter().copied(),
-            );
-            let x = svd.solve(&b, 1e-12).ok()?;
-            Some(
+        for (s, (y, offset)) in signals.iter().enumerate() {
+            let v = y[k - offset];
+            for (i, p) in phi.iter().enumerate() {
+                rhs[(i, s)] += p * v;
+            }
+        }
+    }
+    gram.fill_lower_triangle_with_upper_triangle();
+    let x = match gram.clone().cholesky() {
+        Some(c) => c.solve(&rhs),
+        None => gram.svd(true, true).solve(&rhs, 1e-12).ok()?,
+    };
+    Some(
+        (0..signals.len())
+            .map(|s| {
                 (0..orders.len())
-                    .map(|m| Complex64::new(x[TREND_TERMS + 2 * m], -x[TREND_TERMS + 1 + 2 * m]))
-                    .collect(),
-            )
-        })
-        .collect()
+                    .map(|m| {
+                        Complex64::new(
+                            x[(TREND_TERMS + 2 * m, s)],
+                            -x[(TREND_TERMS + 1 + 2 * m, s)],
+                        )
+                    })
+                    .collect()
+            })
+            .collect(),
+    )
 }
 
 /// The lines of every steady window at `candidates` (and their neighbours), with the
@@ -248,14 +267,16 @@ pub fn window_lines(
                 // rotation.
                 let (a, b) = (theta[rows.start], theta[rows.end - 1]);
                 let (ta, tb) = (t[rows.start], t[rows.end - 1]);
-                let mut v = vec![0.0; facts.rows];
-                for k in rows.clone() {
-                    v[k] = theta[k] - (a + (b - a) * (t[k] - ta) / (tb - ta));
-                }
-                v
+                rows.clone()
+                    .map(|k| theta[k] - (a + (b - a) * (t[k] - ta) / (tb - ta)))
+                    .collect()
             };
-            let mut signals: Vec<(&[f64], usize)> =
-                vec![(&log.iq_a, 0), (&log.id_a, 0), (&trend, 0), (&log.p_pa, 0)];
+            let mut signals: Vec<(&[f64], usize)> = vec![
+                (&log.iq_a, 0),
+                (&log.id_a, 0),
+                (&trend, rows.start),
+                (&log.p_pa, 0),
+            ];
             let voltages = log.ud_v.as_deref().zip(log.uq_v.as_deref());
             if let Some((ud, uq)) = voltages {
                 signals.extend([(ud, 0), (uq, 0)]);

@@ -328,13 +328,14 @@ impl Mechanics {
     ) {
         let j = self.params.inertia_kg_m2;
         let slow = &motion.iq_mean_a;
+        let base = rows.start;
         for k in rows {
             let w = motion.speed_rad_s[k];
             let need = self.load_torque(log, facts, k, w) + j * motion.accel_rad_s2[k];
             let (slope, rest) = self.torque_terms(log, facts, k);
             let slope = if slope.abs() > 1e-9 { slope } else { 1e-9 };
             let t_mean = slope * slow[k] + rest;
-            out[k] = (need - rest + self.line_torque(log, facts, motion, k, t_mean)) / slope;
+            out[k - base] = (need - rest + self.line_torque(log, facts, motion, k, t_mean)) / slope;
         }
     }
 

@@ -210,11 +210,15 @@ impl Relation for MechanicalRelation<'_> {
         let sigma = self.facts.noise(Signal::Iq).unwrap_or(1.0).max(1e-6)
             / ((2 * MECHANICAL_SMOOTHING_ROWS + 1) as f64).sqrt();
         let model = Mechanics::new(mechanical_params(self.rig, values));
-        let mut pred = vec![0.0; self.facts.rows];
         let mut out = Vec::new();
         for r in rows {
+            let mut pred = vec![0.0; r.len()];
             model.needed_current(self.log, self.facts, self.motion, r.clone(), &mut pred);
-            let mut e: Vec<f64> = r.clone().map(|k| self.log.iq_a[k] - pred[k]).collect();
+            let mut e: Vec<f64> = r
+                .clone()
+                .zip(&pred)
+                .map(|(k, p)| self.log.iq_a[k] - p)
+                .collect();
             let basis = self.basis(r);
             mechanical_window_residuals(&mut e, basis.as_ref(), sigma, &mut out);
         }

@@ -20,12 +20,14 @@
 //! - [`diagnosis`]: the contract's JSON; [`report`]: the markdown report; [`command`]: the
 //!   CLI.
 
+pub mod ambiguity;
 pub mod analysis;
 pub mod angle_locked;
 pub mod back_emf;
 pub mod calibration;
 pub mod candidates;
 pub mod command;
+pub mod contributions;
 pub mod cylinder;
 pub mod dead_time;
 pub mod decision;

@@ -2,16 +2,26 @@
 //! simulated before and after the extension on the leading cause's signals, the residual
 //! order spectra with the candidates' orders marked, and the ranking with its evidence.
 //!
-//! Every file is rendered into a staging folder next to DIR and moved in only when all
-//! of them are written, so a failure leaves DIR as it was.
+//! The folder is one output of the command's transaction ([`crate::output::Outputs`]): its
+//! files are written into a staging folder that replaces DIR whole at the end, so a
+//! failure leaves DIR as it was and no file of an earlier log stays beside the new ones.
 
 use super::analysis::Analysis;
 use super::diagnosis::Diagnosis;
 use super::spectrum::OrderSpectrum;
-use crate::output::CliError;
-use crate::plots::{line_chart, png, stacked_chart, Marker, Panel, Series};
+use crate::output::{CliError, StagedFolder};
+use crate::plots::{line_chart, png, stacked_chart, Figure, Marker, Panel, Series};
 use std::fmt::Write as _;
 use std::path::Path;
+
+/// The files a report folder holds.
+pub const FILES: &[&str] = &[
+    "report.md",
+    "trace_*.svg",
+    "trace_*.png",
+    "residual_spectrum_*.svg",
+    "residual_spectrum_*.png",
+];
 
 /// Points per trace in a plot (the SVG stays small on long logs).
 const MAX_POINTS: usize = 4000;
@@ -25,25 +35,21 @@ fn decimated(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Links a figure in the report (its PNG, readable in any viewer, and the SVG) and lists
-/// both files for the move out of the staging folder.
-fn figure(md: &mut String, files: &mut Vec<String>, what: &str, svg: &str) {
+/// Links a figure in the report (its PNG, readable in any viewer, and the SVG).
+fn figure(md: &mut String, what: &str, svg: &str) {
     let png = png::beside(Path::new(svg)).display().to_string();
     let _ = writeln!(md, "![{what}]({png}) ([SVG]({svg}))\n");
-    files.push(svg.to_string());
-    files.push(png);
 }
 
 /// A signal's figure: measured, nominal and extended model above; beneath, on its own
 /// scale, the residual of each model (measured − model). `[y, b, e]` are the measured,
 /// nominal and extended series over `t`; the validation segment starts at `t_val`.
 fn trace_figure(
-    path: &Path,
     signal: &str,
     t: &[f64],
     [y, b, e]: [&Vec<f64>; 3],
     t_val: f64,
-) -> Result<(), String> {
+) -> Result<Figure, String> {
     // Pressures read in MPa: a 5 MPa axis in pascals is seven digits a tick.
     let (scale, unit) = display_unit(unit_of(signal));
     let shown = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x * scale).collect() };
@@ -80,7 +86,6 @@ fn trace_figure(
     let signal_label = format!("{signal} [{unit}]");
     let residual_label = format!("residual [{unit}]");
     stacked_chart(
-        path,
         &format!("{signal}: measured, nominal model, extended model; the residuals beneath"),
         "t [s]",
         &[
@@ -112,47 +117,17 @@ fn failed(what: &str, e: impl std::fmt::Display) -> CliError {
     CliError::Failed(format!("report: {what}: {e}"))
 }
 
-/// Writes the report of `analysis` (of the log at `log_path`) into `dir`.
-pub fn write_report(dir: &Path, log_path: &Path, analysis: &Analysis) -> Result<(), CliError> {
-    let parent = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| failed(&parent.display().to_string(), e))?;
-    let name = dir
-        .file_name()
-        .map_or("report".into(), |n| n.to_string_lossy().to_string());
-    let staging = parent.join(format!(".{name}.staging-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&staging);
-    std::fs::create_dir_all(&staging).map_err(|e| failed(&dir.display().to_string(), e))?;
-    let _cleanup = crate::output::interrupt::remove_on_interrupt(&staging);
-    let result = render(&staging, log_path, analysis).and_then(|files| {
-        std::fs::create_dir_all(dir).map_err(|e| failed(&dir.display().to_string(), e))?;
-        for f in files {
-            crate::output::atomic::rename_into(&staging.join(&f), &dir.join(&f))
-                .map_err(|e| failed(&dir.join(&f).display().to_string(), e))?;
-        }
-        Ok(())
-    });
-    let _ = std::fs::remove_dir_all(&staging);
-    result
-}
-
-/// Renders every file of the report into `dir`: the markdown's sections in order, the
-/// figures they link, then `report.md`. Returns the files written, for the move.
-fn render(dir: &Path, log_path: &Path, a: &Analysis) -> Result<Vec<String>, CliError> {
-    let d = &a.diagnosis;
-    let mut files = Vec::new();
+/// Writes the report of `analysis` (of the log at `log_path`) into the staged folder `d`:
+/// the markdown's sections in order, the figures they link, then `report.md`.
+pub fn write_report(out: &StagedFolder, log_path: &Path, a: &Analysis) -> Result<(), CliError> {
     let mut md = String::new();
-    summary_section(&mut md, log_path, d);
-    ranking_section(&mut md, d);
+    summary_section(&mut md, log_path, &a.diagnosis);
+    ranking_section(&mut md, &a.diagnosis);
+    contributions_section(&mut md, a);
     signatures_section(&mut md, a);
-    trace_section(dir, &mut md, &mut files, a)?;
-    spectrum_section(dir, &mut md, &mut files, a)?;
-    crate::output::atomic::write(&dir.join("report.md"), md.as_bytes())
-        .map_err(|e| failed("report.md", e))?;
-    files.push("report.md".into());
-    Ok(files)
+    trace_section(out, &mut md, a)?;
+    spectrum_section(out, &mut md, a)?;
+    out.file("report.md", md.as_bytes())
 }
 
 /// The title, the leading cause with its evidence, the segments, the per-signal fit table
@@ -220,6 +195,34 @@ fn ranking_section(md: &mut String, d: &Diagnosis) {
     }
 }
 
+/// Each named effect's fit points gained per signal as it joins the model.
+fn contributions_section(md: &mut String, a: &Analysis) {
+    let Some((_, first)) = a.contributions.first() else {
+        return;
+    };
+    let signals: Vec<&String> = first.keys().collect();
+    let _ = writeln!(
+        md,
+        "## Contributions\n\nFit points on the validation segment each named effect gains \
+         per signal as it joins the model, the strongest first (the last row ends at the \
+         extended model).\n\n| effect | {} |\n|---|{}",
+        signals
+            .iter()
+            .map(|s| format!("`{s}`"))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        "---|".repeat(signals.len())
+    );
+    for (effect, gained) in &a.contributions {
+        let cells: Vec<String> = signals
+            .iter()
+            .map(|s| gained.get(*s).map_or("—".into(), |g| format!("{g:+.1}")))
+            .collect();
+        let _ = writeln!(md, "| `{effect}` | {} |", cells.join(" | "));
+    }
+    md.push('\n');
+}
+
 /// The baseline residuals' time-domain signatures, when there are any.
 fn signatures_section(md: &mut String, a: &Analysis) {
     if a.signatures.is_empty() {
@@ -251,13 +254,8 @@ fn signatures_section(md: &mut String, a: &Analysis) {
 }
 
 /// One trace figure ([`trace_figure`]) per predicted signal that was also measured,
-/// written into `dir` and linked from the report.
-fn trace_section(
-    dir: &Path,
-    md: &mut String,
-    files: &mut Vec<String>,
-    a: &Analysis,
-) -> Result<(), CliError> {
+/// written into `d` and linked from the report.
+fn trace_section(d: &StagedFolder, md: &mut String, a: &Analysis) -> Result<(), CliError> {
     let signals: Vec<&'static str> = a.baseline.keys().copied().collect();
     let _ = writeln!(md, "\n## Measured and simulated\n");
     for s in signals {
@@ -266,27 +264,17 @@ fn trace_section(
             continue;
         };
         let file = format!("trace_{s}.svg");
-        trace_figure(
-            &dir.join(&file),
-            s,
-            &a.t_s,
-            [y, b, e],
-            a.diagnosis.validation_segment_s[0],
-        )
-        .map_err(|e| failed(&file, e))?;
-        figure(md, files, s, &file);
+        trace_figure(s, &a.t_s, [y, b, e], a.diagnosis.validation_segment_s[0])
+            .map_err(|e| failed(&file, e))?
+            .write_into(d, &file)?;
+        figure(md, s, &file);
     }
     Ok(())
 }
 
 /// One residual order spectrum figure per spectrum of the analysis, the candidates'
-/// orders marked, written into `dir` and linked from the report.
-fn spectrum_section(
-    dir: &Path,
-    md: &mut String,
-    files: &mut Vec<String>,
-    a: &Analysis,
-) -> Result<(), CliError> {
+/// orders marked, written into `d` and linked from the report.
+fn spectrum_section(d: &StagedFolder, md: &mut String, a: &Analysis) -> Result<(), CliError> {
     let _ = writeln!(md, "## Residual order spectra (nominal model)\n");
     let labels: Vec<String> = a
         .candidate_orders
@@ -304,19 +292,20 @@ fn spectrum_section(
         .collect();
     for (s, spec) in &a.spectra {
         let file = format!("residual_spectrum_{s}.svg");
-        spectrum_figure(&dir.join(&file), s, spec, &markers).map_err(|e| failed(&file, e))?;
-        figure(md, files, &format!("{s} residual spectrum"), &file);
+        spectrum_figure(s, spec, &markers)
+            .map_err(|e| failed(&file, e))?
+            .write_into(d, &file)?;
+        figure(md, &format!("{s} residual spectrum"), &file);
     }
     Ok(())
 }
 
 /// A residual's order spectrum over orders 1–200 with `markers` at the candidates' orders.
 fn spectrum_figure(
-    path: &Path,
     signal: &str,
     spec: &OrderSpectrum,
     markers: &[Marker<'_>],
-) -> Result<(), String> {
+) -> Result<Figure, String> {
     let points: Vec<(f64, f64)> = spec
         .amplitude
         .iter()
@@ -326,7 +315,6 @@ fn spectrum_figure(
         .map(|(k, v)| (k as f64, *v))
         .collect();
     line_chart(
-        path,
         &format!(
             "{signal} residual against shaft angle ({} revolutions)",
             spec.revolutions

@@ -93,6 +93,7 @@ pub(super) fn assemble(
         signatures,
         candidate_orders: candidate_orders(rig),
         tested,
+        contributions: Vec::new(),
     }
 }
 
@@ -244,7 +245,7 @@ pub(super) fn extended_values(
 }
 
 /// The contract's fit of `predicted` over `rows`.
-fn fit_of(
+pub(super) fn fit_of(
     log: &BenchLog,
     facts: &LogFacts,
     predicted: &BTreeMap<&'static str, Vec<f64>>,

@@ -18,8 +18,10 @@
 //!   the dead time and the flux harmonics, which share the lines at 6·p_n, through the
 //!   veto of [`apply_vetoes`]).
 //!
-//! The named effects are ranked by Λ over its χ² threshold, the strongest first.
+//! The named effects are ranked by Λ over its χ² threshold, the strongest first; what the
+//! log cannot tell them from is marked beside them ([`super::ambiguity`]).
 
+use super::ambiguity::mark;
 use super::analysis::Relations;
 use super::calibration::{calibrate, test_release, Calibration, Freed, Relation, Release};
 use super::candidates::{from_release, Extension, Tested};
@@ -49,6 +51,7 @@ pub(super) fn select(
     rig: &Rig,
 ) -> (Vec<usize>, Option<Vec<f64>>) {
     apply_vetoes(tested);
+    let first: Vec<f64> = tested.iter().map(|t| t.lambda).collect();
     let mut named: Vec<usize> = Vec::new();
     // Every relation but the hydraulic one, and every line: once per effect.
     for (i, t) in tested.iter().enumerate() {
@@ -64,6 +67,13 @@ pub(super) fn select(
     let (hydraulic, values) = forward_hydraulic(rel, tested, rig);
     named.extend(hydraulic);
     named.sort_by(|a, b| strength(&tested[*b]).total_cmp(&strength(&tested[*a])));
+    mark(
+        tested,
+        &named,
+        &first,
+        rel.hydraulic.facts(),
+        rig.oil.bulk_modulus_pa,
+    );
     (named, values)
 }
 

@@ -13,11 +13,12 @@
 //! Only outcomes that the log's content decides are kept: a diagnosis, or a log the
 //! diagnosis refuses as bad input (exit status 2). A diagnosis that was killed, timed out
 //! or failed otherwise is not kept, so the next run tries it again. A record made on
-//! another rig or by another version of eha does not count. Records are written
-//! atomically, so a run killed at any moment leaves whole records or none; the Dask driver
+//! another rig or by another version of eha does not count. Each record is an output
+//! transaction of its own ([`crate::output::Outputs`]), committed the moment the outcome
+//! is known, so a run killed at any moment leaves whole records or none; the Dask driver
 //! (`tools/fleet_dask.py`) writes the same records.
 
-use crate::output::atomic;
+use crate::output::{CliError, Outputs};
 use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::fs::File;
@@ -93,8 +94,9 @@ pub fn load(out: &Path, sha256: &str, ctx: &Context) -> Option<Outcome> {
     }
 }
 
-/// Keeps `outcome` for the log of hash `sha256`, atomically.
-pub fn store(out: &Path, sha256: &str, ctx: &Context, outcome: &Outcome) -> io::Result<()> {
+/// Keeps `outcome` for the log of hash `sha256` in the output folder `out` (given by
+/// `--out`), whole or not at all.
+pub fn store(out: &Path, sha256: &str, ctx: &Context, outcome: &Outcome) -> Result<(), CliError> {
     let mut v = json!({
         "sha256": sha256,
         "rig_sha256": ctx.rig_sha256,
@@ -110,10 +112,15 @@ pub fn store(out: &Path, sha256: &str, ctx: &Context, outcome: &Outcome) -> io::
             v["error"] = json!(e);
         }
     }
-    let path = record_path(out, sha256);
-    std::fs::create_dir_all(out.join(FOLDER))?;
-    let text = serde_json::to_string(&v).map_err(io::Error::other)?;
-    atomic::write(&path, text.as_bytes())
+    let folder = out.join(FOLDER);
+    std::fs::create_dir_all(&folder).map_err(|source| CliError::Write {
+        file: folder,
+        source,
+    })?;
+    let text = serde_json::to_string(&v).map_err(|e| CliError::Failed(e.to_string()))?;
+    let mut outputs = Outputs::new();
+    outputs.file("--out", &record_path(out, sha256), text.as_bytes())?;
+    outputs.commit()
 }
 
 #[cfg(test)]

@@ -5,10 +5,10 @@
 //! letters, digits, `-`, `_` and `.`.
 
 use super::drift::DriveTrend;
+use crate::output::{CliError, StagedFolder};
 use crate::plots::trend::{trend_chart, TrendPanel};
 use crate::timestamp::date;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
 
 /// Days per (Gregorian mean) year. [day]
 const DAYS_PER_YEAR: f64 = 365.2425;
@@ -105,9 +105,12 @@ fn panel(t: &DriveTrend) -> TrendPanel {
     }
 }
 
-/// Writes the figure of every drive with a drifting parameter into `dir`; returns the
-/// SVG files written.
-pub fn write(dir: &Path, trends: &[DriveTrend]) -> Result<Vec<PathBuf>, String> {
+/// The files the figures' folder holds: each drive's SVG and the PNG beside it.
+pub const FILES: &[&str] = &["*.svg", "*.png"];
+
+/// Writes the figure of every drive with a drifting parameter into the staged folder `d`;
+/// returns the names of the SVG files written.
+pub fn write(d: &StagedFolder, trends: &[DriveTrend]) -> Result<Vec<String>, CliError> {
     let mut by_drive: BTreeMap<&str, Vec<&DriveTrend>> = BTreeMap::new();
     for t in trends.iter().filter(|t| t.drifting()) {
         by_drive.entry(&t.drive).or_default().push(t);
@@ -123,14 +126,16 @@ pub fn write(dir: &Path, trends: &[DriveTrend]) -> Result<Vec<PathBuf>, String> 
             n += 1;
             stem = format!("{base}-{n}");
         }
-        let path = dir.join(format!("{stem}.svg"));
+        let name = format!("{stem}.svg");
         let panels: Vec<TrendPanel> = ts.iter().map(|t| panel(t)).collect();
         trend_chart(
-            &path,
+            &name,
             &format!("drive {drive}: drifting parameters"),
             &panels,
-        )?;
-        written.push(path);
+        )
+        .map_err(CliError::Failed)?
+        .write_into(d, &name)?;
+        written.push(name);
     }
     Ok(written)
 }

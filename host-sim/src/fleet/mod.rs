@@ -10,7 +10,8 @@
 //! - [`table`]: one row per log; [`drift`] and [`trend`]: per drive and parameter, the
 //!   weighted straight-line trend, its significance, the value now and the crossing of
 //!   the [`limits`]; [`figures`]: a figure per drifting drive.
-//! - [`commit`]: the tables and figures written into the output folder, in one place.
+//! - [`commit`]: the tables and figures staged for the output folder, in one place, and
+//!   committed with the run's standard output and `--json` as one transaction.
 //!
 //! Exit status: 0 when every log was diagnosed, 1 when some were not (their rows say why),
 //! 2 for bad arguments (checked before any log is diagnosed).
@@ -25,8 +26,8 @@ pub mod runner;
 pub mod table;
 pub mod trend;
 
-use crate::output::paths::Declared;
-use crate::output::{print_stdout, write_json, CliError};
+use crate::output::paths::{self, Declared};
+use crate::output::{CliError, Outputs};
 use crate::values::positive_f64;
 use cache::{Context, Outcome};
 use clap::Args;
@@ -83,14 +84,25 @@ pub struct FleetArgs {
 }
 
 impl FleetArgs {
-    /// The files and folders it reads and writes (the logs themselves are checked one by
-    /// one: an unreadable log is a row, not a bad argument).
+    /// The files it reads and writes (the logs themselves are checked one by one: an
+    /// unreadable log is a row, not a bad argument). The output folder is kept across runs,
+    /// not replaced whole: [`FleetArgs::check_out`] checks it.
     pub fn paths(&self) -> Declared<'_> {
         Declared::default()
             .input("--manifest", self.manifest.as_ref())
-            .dir("--out", Some(&self.out))
             .file("--json", self.json.as_ref())
             .file("--plan", self.plan.as_ref())
+    }
+
+    /// Checks `--out`: a folder that is or can be made, in which eha can create files, and
+    /// no other output's path.
+    fn check_out(&self) -> Result<(), CliError> {
+        let inputs: Vec<&Path> = self.manifest.iter().map(PathBuf::as_path).collect();
+        paths::kept_dir("--out", &self.out, &inputs)?;
+        let mut outputs = vec![("--out", self.out.as_path())];
+        outputs.extend(self.json.as_deref().map(|p| ("--json", p)));
+        outputs.extend(self.plan.as_deref().map(|p| ("--plan", p)));
+        paths::distinct(&outputs)
     }
 }
 
@@ -99,11 +111,7 @@ fn rig_identity(rig_file: Option<&Path>) -> Result<String, CliError> {
     match rig_file {
         None => Ok(cache::NOMINAL_RIG.into()),
         Some(p) => cache::sha256_file(p).map_err(|e| {
-            CliError::BadInput(format!(
-                "--rig `{}`: {}",
-                p.display(),
-                crate::output::paths::describe(&e)
-            ))
+            CliError::BadInput(format!("--rig `{}`: {}", p.display(), paths::describe(&e)))
         }),
     }
 }
@@ -117,7 +125,7 @@ fn hash_all(entries: &[Entry], jobs: usize) -> Vec<Result<String, String>> {
             format!(
                 "bench log `{}`: {}",
                 e.path.display(),
-                crate::output::paths::describe(&err)
+                paths::describe(&err)
             )
         }),
     };
@@ -209,12 +217,9 @@ fn diagnose_all(
         bar.inc(1);
         if let Ran::Kept(o) = &f.ran {
             let h = to_run[i].0;
-            if let Err(source) = cache::store(out, h, ctx, o) {
+            if let Err(err) = cache::store(out, h, ctx, o) {
                 if let Ok(mut e) = store_error.lock() {
-                    e.get_or_insert(CliError::Write {
-                        file: cache::record_path(out, h),
-                        source,
-                    });
+                    e.get_or_insert(err);
                 }
             }
         }
@@ -318,6 +323,7 @@ fn summary_text(rows: &[Row], r: &Results, trends: &[drift::DriveTrend], out: &P
 /// `eha fleet`.
 pub fn run_fleet(rig: &Rig, rig_file: Option<&Path>, args: &FleetArgs) -> Result<(), CliError> {
     let start = Instant::now();
+    args.check_out()?;
     let limits = limits::limits(rig, args.pressure, args.leakage_limit)?;
     let ctx = Context {
         rig_sha256: rig_identity(rig_file)?,
@@ -351,14 +357,21 @@ pub fn run_fleet(rig: &Rig, rig_file: Option<&Path>, args: &FleetArgs) -> Result
     };
     let hashes = hash_all(&entries, jobs);
     if let Some(path) = &args.plan {
-        return write_json(path, &plan(&entries, &hashes, &args.out, &ctx, rig_file));
+        let mut outputs = Outputs::new();
+        outputs.json(
+            "--plan",
+            path,
+            &plan(&entries, &hashes, &args.out, &ctx, rig_file),
+        )?;
+        return outputs.commit();
     }
     let results = diagnose_all(&entries, &hashes, &args.out, &ctx, &runner, jobs)?;
     let rows = rows(entries, hashes, &results);
     let trends = drift::trends(&rows, &limits);
-    let figures = commit::commit(&args.out, &rows, &trends)?;
+    let mut outputs = Outputs::new();
+    let figures = commit::stage(&mut outputs, &args.out, &rows, &trends)?;
     if !args.json.as_deref().is_some_and(crate::output::is_stdout) {
-        print_stdout(&summary_text(&rows, &results, &trends, &args.out))?;
+        outputs.print(&summary_text(&rows, &results, &trends, &args.out));
     }
     let failed = rows.iter().filter(|r| r.result.is_err()).count();
     if let Some(path) = &args.json {
@@ -377,7 +390,8 @@ pub fn run_fleet(rig: &Rig, rig_file: Option<&Path>, args: &FleetArgs) -> Result
                 })
             })
             .collect();
-        write_json(
+        outputs.json(
+            "--json",
             path,
             &json!({
                 "logs": rows.len(),
@@ -400,6 +414,7 @@ pub fn run_fleet(rig: &Rig, rig_file: Option<&Path>, args: &FleetArgs) -> Result
             }),
         )?;
     }
+    outputs.commit()?;
     if failed > 0 {
         return Err(CliError::Failed(format!(
             "{failed} of {} logs could not be diagnosed; their rows in {} say why",

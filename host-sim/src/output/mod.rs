@@ -1,16 +1,60 @@
 //! What every subcommand reports through: the error type [`CliError`] with its exit status,
-//! standard output that tolerates a closed pipe ([`print_stdout`]), JSON documents written
-//! to a file or standard output ([`write_json`]), and output files that appear whole or not
-//! at all ([`atomic`]); the paths a subcommand is given, checked before it runs
-//! ([`paths`]); and clean-up when a run is interrupted ([`interrupt`]).
+//! the paths it is given, checked before it runs ([`paths`], [`folder`]), its outputs as one
+//! transaction ([`transaction`]: every file, folder and standard output of a command
+//! written together at the end, or none), clean-up when a run is interrupted
+//! ([`interrupt`]), and progress on a terminal ([`progress`]).
 //!
 //! Exit status: 0 on success, 2 for bad input or arguments (a bad rig file, a bad bench
 //! log, a value out of range), 1 for anything else; the message goes to standard error.
+//!
+//! # Writing a command's outputs
+//!
+//! A command declares the paths it reads and writes, with the files an output folder of
+//! its own may hold; `eha` checks them all before the command starts ([`paths::check`]):
+//!
+//! ```ignore
+//! /// The files `eha fleet` writes into its folder.
+//! pub const FILES: &[&str] = &["fleet.csv", "fleet.json", "trends.csv", "trend_*.svg", "trend_*.png"];
+//!
+//! impl FleetArgs {
+//!     pub fn paths(&self) -> Declared<'_> {
+//!         Declared::default()
+//!             .input("--manifest", self.manifest.as_ref())
+//!             .dir("--out", Some(&self.out), FILES)
+//!             .file("--json", self.json.as_ref())
+//!     }
+//! }
+//! ```
+//!
+//! When its work is done it stages every output, then commits them together:
+//!
+//! ```ignore
+//! let mut out = Outputs::new();
+//! out.folder("--out", &args.out, FILES, |d| {
+//!     d.file("fleet.csv", table.as_bytes())?;            // or d.file_with(name, |w| …)
+//!     figure.write_into(d, "trend_drive7.svg")?;          // plots render, the folder writes
+//!     Ok(())
+//! })?;
+//! if let Some(path) = &args.json {
+//!     out.json("--json", path, &value)?;                  // `-`: standard output
+//! }
+//! out.print(&summary);                                    // standard output, after the files
+//! out.commit()
+//! ```
+//!
+//! Nothing appears until [`Outputs::commit`]; an error (or `?`) before it drops the
+//! transaction and removes what was staged. A command that keeps results across runs
+//! commits each in a transaction of its own; an interruption then keeps the committed
+//! ones and says so.
 
-pub mod atomic;
+pub mod folder;
+pub mod hooks;
 pub mod interrupt;
 pub mod paths;
 pub mod progress;
+pub mod transaction;
+
+pub use transaction::{Outputs, StagedFolder};
 
 use crate::bench_log::BenchLogError;
 use crate::rig_file::RigFileError;
@@ -29,13 +73,22 @@ pub enum CliError {
     /// An argument or input value that makes no sense.
     #[error("{0}")]
     BadInput(String),
-    /// An output file that cannot be written.
-    #[error("cannot write `{}`: {source}", file.display())]
+    /// An output that cannot be staged or moved into place: none of the command's
+    /// outputs is written.
+    #[error("cannot write `{}`: {}; no output written", file.display(), paths::describe(source))]
     Write {
         /// The file.
         file: PathBuf,
         /// Why.
         source: io::Error,
+    },
+    /// Standard output that cannot be written (a closed pipe is no error).
+    #[error("cannot write standard output: {}{}", paths::describe(source), written(*files_written))]
+    Stdout {
+        /// Why.
+        source: io::Error,
+        /// Outputs (files and folders) in place before: all of the command's others.
+        files_written: usize,
     },
     /// Any other failure.
     #[error("{0}")]
@@ -58,18 +111,12 @@ pub fn is_stdout(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
-/// Writes one JSON object, pretty-printed, to `path` atomically or to standard output.
-pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), CliError> {
-    let mut text =
-        serde_json::to_string_pretty(value).map_err(|e| CliError::Failed(e.to_string()))?;
-    text.push('\n');
-    if is_stdout(path) {
-        print_stdout(&text)
+/// `; its other outputs were written` when there were any.
+fn written(files: usize) -> &'static str {
+    if files == 0 {
+        ""
     } else {
-        atomic::write(path, text.as_bytes()).map_err(|source| CliError::Write {
-            file: path.to_path_buf(),
-            source,
-        })
+        "; the command's other outputs were written"
     }
 }
 
@@ -77,9 +124,9 @@ pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), CliError
 pub fn print_stdout(text: &str) -> Result<(), CliError> {
     let mut out = io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => Err(CliError::Write {
-            file: PathBuf::from("<standard output>"),
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => Err(CliError::Stdout {
             source: e,
+            files_written: 0,
         }),
         _ => Ok(()),
     }

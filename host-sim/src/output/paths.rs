@@ -1,7 +1,9 @@
 //! The paths a subcommand is given, checked before it starts any work: inputs exist and are
 //! files the command can read to their end; outputs are regular files (or folders) it may
-//! create or replace, in a folder it can write, none of them an input or another output.
-//! A failed check is bad input (exit status 2) and leaves nothing behind.
+//! create or replace, in a folder it can write, none of them an input or another output,
+//! and no output file inside an output folder (which is replaced whole); an existing output
+//! folder holds only files the command writes there ([`super::folder`]). A failed check is
+//! bad input (exit status 2) and leaves nothing behind.
 //!
 //! Special files are never replaced: an output naming a FIFO, a device node or a socket is
 //! refused (`-` is standard output), a symbolic link is followed to the regular file it
@@ -15,7 +17,7 @@ use std::io;
 use std::path::{Component, Path, PathBuf};
 
 /// What kind of file system object a path is, in words.
-fn kind(m: &Metadata) -> &'static str {
+pub(super) fn kind(m: &Metadata) -> &'static str {
     let t = m.file_type();
     if t.is_dir() {
         return "a folder";
@@ -59,7 +61,7 @@ fn is_fifo(m: &Metadata) -> bool {
     }
 }
 
-fn bad(flag: &str, path: &Path, why: impl std::fmt::Display) -> CliError {
+pub(super) fn bad(flag: &str, path: &Path, why: impl std::fmt::Display) -> CliError {
     let name = if flag.is_empty() {
         format!("`{}`", path.display())
     } else {
@@ -76,8 +78,9 @@ pub struct Declared<'a> {
     pub inputs: Vec<(&'static str, &'a Path)>,
     /// Files written (`-`: standard output).
     pub files: Vec<(&'static str, &'a Path)>,
-    /// Folders written into (created if missing).
-    pub dirs: Vec<(&'static str, &'a Path)>,
+    /// Folders written (created if missing, replaced whole), each with the names of the
+    /// files it may hold before ([`super::folder`]).
+    pub dirs: Vec<(&'static str, &'a Path, &'static [&'static str])>,
 }
 
 impl<'a> Declared<'a> {
@@ -93,15 +96,21 @@ impl<'a> Declared<'a> {
         self
     }
 
-    /// Adds an output folder, if given.
-    pub fn dir(mut self, flag: &'static str, path: Option<&'a PathBuf>) -> Self {
-        self.dirs.extend(path.map(|p| (flag, p.as_path())));
+    /// Adds an output folder, if given, into which the command writes files `owned` names
+    /// (`*` standing for any text).
+    pub fn dir(
+        mut self,
+        flag: &'static str,
+        path: Option<&'a PathBuf>,
+        owned: &'static [&'static str],
+    ) -> Self {
+        self.dirs.extend(path.map(|p| (flag, p.as_path(), owned)));
         self
     }
 }
 
 /// Checks every declared path: inputs readable, outputs writable and none an input, no two
-/// outputs the same.
+/// outputs the same, no output file inside an output folder.
 pub fn check(d: &Declared) -> Result<(), CliError> {
     for (flag, p) in &d.inputs {
         input_file(flag, p)?;
@@ -110,11 +119,33 @@ pub fn check(d: &Declared) -> Result<(), CliError> {
     for (flag, p) in &d.files {
         output_file(flag, p, &inputs)?;
     }
-    for (flag, p) in &d.dirs {
-        output_dir(flag, p, &inputs)?;
+    for (flag, p, owned) in &d.dirs {
+        output_dir(flag, p, &inputs, owned)?;
     }
-    let outputs: Vec<(&str, &Path)> = d.files.iter().chain(&d.dirs).copied().collect();
-    distinct(&outputs)
+    let folders: Vec<(&str, &Path)> = d.dirs.iter().map(|(f, p, _)| (*f, *p)).collect();
+    let outputs: Vec<(&str, &Path)> = d.files.iter().chain(&folders).copied().collect();
+    distinct(&outputs)?;
+    for (ff, file) in d.files.iter().filter(|(_, p)| !is_stdout(p)) {
+        for (fd, dir) in &folders {
+            if lies_in(file, dir) {
+                return Err(CliError::BadInput(format!(
+                    "{ff} `{}` lies in the {fd} folder `{}`, which eha replaces whole: name a \
+                     file outside it",
+                    file.display(),
+                    dir.display()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether the file `file` (existing or not) lies in the folder `dir` or below it.
+fn lies_in(file: &Path, dir: &Path) -> bool {
+    let (Ok(dir), Ok(parent)) = (fs::canonicalize(dir), fs::canonicalize(parent_of(file))) else {
+        return false;
+    };
+    parent.starts_with(dir)
 }
 
 /// Checks an input file: it exists and is a regular file or a pipe.
@@ -174,14 +205,6 @@ pub fn replaced_file(path: &Path) -> io::Result<Option<PathBuf>> {
     }
 }
 
-/// Checks a file a subcommand writes into its output folder: nothing there yet, a regular
-/// file, or a link to one (the folder itself is checked by [`output_dir`]).
-pub fn replaceable(flag: &str, path: &Path) -> Result<(), CliError> {
-    replaced_file(path)
-        .map(|_| ())
-        .map_err(|e| bad(flag, path, describe(&e)))
-}
-
 /// Checks an output file path (`-` is standard output and always fine) against the inputs
 /// it must not overwrite.
 pub fn output_file(flag: &str, path: &Path, inputs: &[&Path]) -> Result<(), CliError> {
@@ -215,12 +238,40 @@ pub fn output_file(flag: &str, path: &Path, inputs: &[&Path]) -> Result<(), CliE
     writable_folder(flag, path, parent_of(&written))
 }
 
-/// Checks an output folder: an existing folder, or one that can be created, in which eha
-/// can create files; none of the inputs.
-pub fn output_dir(flag: &str, path: &Path, inputs: &[&Path]) -> Result<(), CliError> {
+/// Checks an output folder: an existing folder holding only files `owned` names (none of
+/// the inputs), or one that can be created; either in a folder where eha can create files
+/// (its staging folder goes there).
+pub fn output_dir(
+    flag: &str,
+    path: &Path,
+    inputs: &[&Path],
+    owned: &[&str],
+) -> Result<(), CliError> {
     if path.as_os_str().is_empty() {
         return Err(CliError::BadInput(format!("{flag}: the path is empty")));
     }
+    if path.file_name().is_none() {
+        return Err(bad(
+            flag,
+            path,
+            "names no folder by its name; eha replaces its output folder whole: name one",
+        ));
+    }
+    let existing = folder_to_be(flag, path, inputs)?;
+    if existing != path {
+        return writable_folder(flag, path, existing);
+    }
+    if let Some(why) = super::folder::problem(path, owned, inputs) {
+        return Err(bad(flag, path, why));
+    }
+    // The folder is replaced by one staged beside it: beside the folder a link names.
+    let place = fs::canonicalize(path).map_err(|e| bad(flag, path, describe(&e)))?;
+    writable_folder(flag, path, parent_of(&place))
+}
+
+/// The nearest existing ancestor of the output folder `path` (or `path`), which must be a
+/// folder (create_dir_all makes the rest); `path` must be none of `inputs`.
+fn folder_to_be<'p>(flag: &str, path: &'p Path, inputs: &[&Path]) -> Result<&'p Path, CliError> {
     for input in inputs {
         if same_file(path, input) {
             return Err(bad(
@@ -252,6 +303,17 @@ pub fn output_dir(flag: &str, path: &Path, inputs: &[&Path]) -> Result<(), CliEr
             Err(e) => return Err(bad(flag, path, describe(&e))),
         }
     }
+    Ok(existing)
+}
+
+/// Checks a folder a command keeps across runs and writes outputs into one by one (`eha
+/// fleet --out`, which holds its kept diagnoses), never replaced whole: not an input, and an
+/// existing folder, or one that can be created, in which eha can create files.
+pub fn kept_dir(flag: &str, path: &Path, inputs: &[&Path]) -> Result<(), CliError> {
+    if path.as_os_str().is_empty() {
+        return Err(CliError::BadInput(format!("{flag}: the path is empty")));
+    }
+    let existing = folder_to_be(flag, path, inputs)?;
     writable_folder(flag, path, existing)
 }
 
@@ -323,7 +385,7 @@ fn writable_folder(flag: &str, path: &Path, folder: &Path) -> Result<(), CliErro
 }
 
 /// Whether two existing paths are the same file (hard links and symbolic links included).
-fn same_file(a: &Path, b: &Path) -> bool {
+pub(super) fn same_file(a: &Path, b: &Path) -> bool {
     match (fs::metadata(a), fs::metadata(b)) {
         (Ok(ma), Ok(mb)) => {
             #[cfg(unix)]

@@ -1,6 +1,8 @@
-//! Plots (plotters, SVG written atomically; a PNG beside each, [`png`]): time traces, spectra with the
-//! physical orders marked, sweep curves, and figures of panels stacked over one time axis
-//! (a signal above, its residual or its measured reading beneath, each on its own scale).
+//! Plots (plotters' SVG, and a PNG of it, [`png`]): time traces, spectra with the physical
+//! orders marked, sweep curves, and figures of panels stacked over one time axis (a signal
+//! above, its residual or its measured reading beneath, each on its own scale). A plot is
+//! rendered into memory as a [`Figure`]; the command's output folder writes it
+//! ([`Figure::write_into`]), so plots are outputs of its transaction like any file.
 //!
 //! Order markers are labelled at the top of their panel in as many rows as it takes for no
 //! label to cover another. Points that are not finite are left out, and the axes span at
@@ -13,9 +15,28 @@ pub mod trend;
 /// Widest axis span drawn (a plot of wider data is refused, not drawn). [axis unit]
 pub const MAX_SPAN: f64 = 1e100;
 
+use crate::output::{CliError, StagedFolder};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
+
+/// A rendered plot: the SVG and the PNG of it.
+pub struct Figure {
+    /// The SVG document.
+    pub svg: String,
+    /// The PNG rendered from it.
+    pub png: Vec<u8>,
+}
+
+impl Figure {
+    /// Writes the figure into the staged folder `d` as `svg_name` (`NAME.svg`) and the PNG
+    /// beside it (`NAME.png`).
+    pub fn write_into(&self, d: &StagedFolder, svg_name: &str) -> Result<(), CliError> {
+        d.file(svg_name, self.svg.as_bytes())?;
+        let png = png::beside(Path::new(svg_name));
+        d.file(&png.to_string_lossy(), &self.png)
+    }
+}
 
 /// One named line.
 pub struct Series<'a> {
@@ -177,34 +198,23 @@ fn drawable(p: &(f64, f64), log_y: bool) -> bool {
 /// A line chart written to `path` (SVG, and a PNG beside it). `log_y` plots y on a log
 /// scale.
 pub fn line_chart(
-    path: &Path,
     title: &str,
     x_label: &str,
     y_label: &str,
     series: &[Series],
     markers: &[Marker],
     log_y: bool,
-) -> Result<(), String> {
+) -> Result<Figure, String> {
     let panel = Panel {
         log_y,
         ..Panel::new(y_label, series).markers(markers)
     };
-    stacked_chart(path, title, x_label, &[panel])
+    stacked_chart(title, x_label, &[panel])
 }
 
-/// Panels stacked over one x axis, written to `path` (SVG, and a PNG beside it).
-pub fn stacked_chart(
-    path: &Path,
-    title: &str,
-    x_label: &str,
-    panels: &[Panel],
-) -> Result<(), String> {
-    // Named by its file name: the folder may be a staging folder the user never sees.
-    let name = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
-    let err = |e: &dyn std::fmt::Display| format!("plot `{name}`: {e}");
+/// Panels stacked over one x axis, rendered.
+pub fn stacked_chart(title: &str, x_label: &str, panels: &[Panel]) -> Result<Figure, String> {
+    let err = |e: &dyn std::fmt::Display| e.to_string();
     let (x0, x1) = x_bounds(panels);
     let span_ok = |s: f64| s.is_finite() && s <= MAX_SPAN;
     for p in panels {
@@ -217,8 +227,6 @@ pub fn stacked_chart(
             )));
         }
     }
-    // Drawn into memory, then written atomically (no half-written SVG, no special file
-    // replaced: `crate::output::atomic`), and the PNG rendered from the same text.
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
@@ -242,10 +250,8 @@ pub fn stacked_chart(
         }
         root.present().map_err(|e| err(&e))?;
     }
-    crate::output::atomic::write(path, svg.as_bytes())
-        .map_err(|e| err(&crate::output::paths::describe(&e)))?;
-    png::render_beside(path, &svg).map_err(|e| err(&e))?;
-    Ok(())
+    let png = png::render(&svg)?;
+    Ok(Figure { svg, png })
 }
 
 /// Rows of marker labels: for each marker (in x order) its row, so that no label overlaps
@@ -393,9 +399,6 @@ mod tests {
 
     #[test]
     fn extreme_and_non_finite_points_end_quickly() {
-        let dir = std::env::temp_dir().join(format!("eha-plots-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("x.svg");
         let wild = Series {
             name: "wild",
             points: vec![
@@ -405,20 +408,22 @@ mod tests {
                 (3.0, f64::INFINITY),
             ],
         };
-        let e = line_chart(&path, "t", "x", "y", &[wild], &[], false).unwrap_err();
+        let e = line_chart("t", "x", "y", &[wild], &[], false)
+            .err()
+            .unwrap();
         assert!(e.contains("too wide"), "{e}");
         let tame = Series {
             name: "tame",
             points: vec![(0.0, 1.0), (1.0, f64::NAN), (2.0, 3.0)],
         };
-        line_chart(&path, "t", "x", "y", &[tame], &[], false).unwrap();
-        // The PNG beside it: a PNG signature and the SVG's size in its header.
-        let png = std::fs::read(dir.join("x.png")).unwrap();
+        let f = line_chart("t", "x", "y", &[tame], &[], false).unwrap();
+        assert!(f.svg.starts_with("<svg"), "{}", &f.svg[..40]);
+        // The PNG: a PNG signature and the SVG's size in its header.
+        let png = f.png;
         assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
         let w = u32::from_be_bytes(png[16..20].try_into().unwrap());
         let h = u32::from_be_bytes(png[20..24].try_into().unwrap());
         assert_eq!((w, h), SIZE);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -46,27 +46,16 @@ pub fn beside(svg: &Path) -> PathBuf {
     svg.with_extension("png")
 }
 
-/// Renders `text`, the SVG written at `svg`, to a PNG beside it (same pixel size),
-/// atomically.
-pub fn render_beside(svg: &Path, text: &str) -> Result<PathBuf, String> {
-    let data = text.as_bytes();
+/// Renders the SVG `text` to a PNG of the same pixel size.
+pub fn render(text: &str) -> Result<Vec<u8>, String> {
     let options = usvg::Options {
         fontdb: fonts(),
         ..usvg::Options::default()
     };
-    let tree = usvg::Tree::from_data(data, &options).map_err(|e| format!("SVG: {e}"))?;
+    let tree = usvg::Tree::from_data(text.as_bytes(), &options).map_err(|e| format!("SVG: {e}"))?;
     let size = tree.size().to_int_size();
     let mut pixmap = Pixmap::new(size.width(), size.height())
         .ok_or_else(|| format!("an image of {}x{} pixels", size.width(), size.height()))?;
     resvg::render(&tree, Transform::default(), &mut pixmap.as_mut());
-    let png = pixmap.encode_png().map_err(|e| format!("PNG: {e}"))?;
-    let out = beside(svg);
-    crate::output::atomic::write(&out, &png).map_err(|e| {
-        format!(
-            "`{}`: {}",
-            out.display(),
-            crate::output::paths::describe(&e)
-        )
-    })?;
-    Ok(out)
+    pixmap.encode_png().map_err(|e| format!("PNG: {e}"))
 }

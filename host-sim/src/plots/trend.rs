@@ -1,10 +1,10 @@
 //! Trend figures (`eha fleet`): per parameter a panel with each log's estimate and its
 //! error bar, the fitted line with its ±2σ band, the limit, and where the line crosses
-//! it with the crossing time's ±2σ interval. SVG written atomically, a PNG beside it.
+//! it with the crossing time's ±2σ interval. Rendered into a [`Figure`] (SVG and PNG), which
+//! the command's staged output folder writes ([`Figure::write_into`]).
 
-use super::{png, MAX_SPAN};
+use super::{png, Figure, MAX_SPAN};
 use plotters::prelude::*;
-use std::path::Path;
 
 /// One panel: one parameter over time. x in years (decimal), y in the panel's unit.
 pub struct TrendPanel {
@@ -43,12 +43,9 @@ fn bounds(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     Some((lo - pad, hi + pad))
 }
 
-/// Draws `panels` stacked under `title` into `path` (SVG) and the PNG beside it.
-pub fn trend_chart(path: &Path, title: &str, panels: &[TrendPanel]) -> Result<(), String> {
-    let name = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
+/// Renders `panels` stacked under `title`; `name` (the figure's file name) names it in
+/// errors.
+pub fn trend_chart(name: &str, title: &str, panels: &[TrendPanel]) -> Result<Figure, String> {
     let err = |e: &dyn std::fmt::Display| format!("plot `{name}`: {e}");
     let height = 60 + PANEL_HEIGHT * panels.len().max(1) as u32;
     let mut svg = String::new();
@@ -64,10 +61,8 @@ pub fn trend_chart(path: &Path, title: &str, panels: &[TrendPanel]) -> Result<()
         }
         root.present().map_err(|e| err(&e))?;
     }
-    crate::output::atomic::write(path, svg.as_bytes())
-        .map_err(|e| err(&crate::output::paths::describe(&e)))?;
-    png::render_beside(path, &svg).map_err(|e| err(&e))?;
-    Ok(())
+    let png = png::render(&svg).map_err(|e| err(&e))?;
+    Ok(Figure { svg, png })
 }
 
 fn draw<DB: DrawingBackend>(

@@ -4,11 +4,12 @@
 //! SVG plots in an output folder.
 
 use super::holding::pulsation;
-use super::{converged, effects_text, plant_rig, rig_name, write_log, LOG_RATE_HZ};
+use super::{converged, effects_text, plant_rig, rig_name, LOG_RATE_HZ};
+use crate::bench_log::write_into;
 use crate::compensate::Feedforward;
-use crate::output::paths::{replaceable, Declared};
-use crate::output::{print_stdout, CliError};
-use crate::plots::{line_chart, stacked_chart, Marker, Panel, Series};
+use crate::output::paths::Declared;
+use crate::output::{CliError, Outputs, StagedFolder};
+use crate::plots::{line_chart, stacked_chart, Figure, Marker, Panel, Series};
 use crate::pulsation::sources;
 use crate::run::{run, Run, RunOptions};
 use clap::Args;
@@ -17,7 +18,7 @@ use plant_model::effects::paper_low_speed_effects;
 use plant_model::{Effect, Rig};
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// `eha demo`.
 #[derive(Debug, Args)]
@@ -30,12 +31,12 @@ pub struct DemoArgs {
 impl DemoArgs {
     /// The files it writes.
     pub fn paths(&self) -> Declared<'_> {
-        Declared::default().dir("--out", Some(&self.out))
+        Declared::default().dir("--out", Some(&self.out), FILES)
     }
 }
 
 /// The files the demo writes into its folder (each figure an SVG and a PNG).
-const FILES: [&str; 14] = [
+pub const FILES: &[&str] = &[
     "pressure-hold.csv",
     "pressure-hold-no-absorber.csv",
     "pressure-step.csv",
@@ -66,15 +67,6 @@ type Job<'a> = (
 /// `eha demo`.
 pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     let out = &args.out;
-    // Checked before the runs: every file is written atomically and never over a special
-    // file, but a refusal after minutes of work would leave the folder half updated.
-    for name in FILES {
-        replaceable("--out", &out.join(name))?;
-    }
-    std::fs::create_dir_all(out).map_err(|source| CliError::Write {
-        file: out.clone(),
-        source,
-    })?;
     let effects: Vec<Effect> = paper_low_speed_effects().to_vec();
     let plant = plant_rig(rig, &effects)?;
     // The reference is the rig without absorber, its controller configured for that rig
@@ -94,7 +86,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             ("source".to_string(), "simulation".to_string()),
             ("rig".into(), rig_name(rig).into()),
             ("scenario".into(), scenario.into()),
-            ("effects".into(), effects_text(&effects)),
+            ("effects".into(), effects_text(rig, &effects)),
             ("absorber".into(), absorber.into()),
         ]
     };
@@ -167,6 +159,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
                     progress: false,
                     metadata: m.clone(),
                     compensation: table.cloned(),
+                    integrator: Default::default(),
                 },
             )
         })
@@ -176,7 +169,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         runs.next()
             .unwrap_or_else(|| Err("run missing".into()))
             .map_err(CliError::Failed)
-            .and_then(converged)
+            .and_then(|r| converged(r, None))
     };
     let (with, without) = (next()?, next()?);
     let (with_ff, without_ff) = (next()?, next()?);
@@ -185,21 +178,6 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     let po = pulsation(&without, hold, &plant);
     let pwf = pulsation(&with_ff, hold, &plant);
     let pof = pulsation(&without_ff, hold, &plant);
-    let table_path = out.join("compensation.table");
-    crate::output::atomic::write(&table_path, &ff_table.file_bytes()).map_err(|source| {
-        CliError::Write {
-            file: table_path.clone(),
-            source,
-        }
-    })?;
-    write_log(&out.join("compensation-sweep.csv"), &ff_logs[0])?;
-
-    let log_path = out.join("pressure-hold.csv");
-    write_log(&log_path, &with.log)?;
-    write_log(&out.join("pressure-hold-no-absorber.csv"), &without.log)?;
-    write_log(&out.join("pressure-step.csv"), &stepped.log)?;
-    write_log(&out.join("speed-step.csv"), &sped.log)?;
-
     let mut table = String::new();
     let _ = writeln!(
         table,
@@ -261,19 +239,61 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         cut(pw.pp_pa, pwf.pp_pa)
     );
 
-    // Plots.
-    pressure_figure(
-        &out.join("pressure_trace.svg"),
-        &with,
-        &without,
-        &without_ff,
-        hold.steady_from_s,
-    )?;
-    let plot = |name: &str, res: Result<(), String>| {
-        res.map_err(|e| CliError::Failed(format!("{name}: {e}")))
+    let _ = writeln!(
+        table,
+        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, compensation-sweep.csv (the feed-forward's bench sweep), compensation.table, pressure_trace, pulsation_spectrum, pressure_step, speed_step (each .svg and .png)",
+        out.display()
+    );
+    let mut outputs = Outputs::new();
+    outputs.folder("--out", out, FILES, |d| {
+        d.file("compensation.table", &ff_table.file_bytes())?;
+        write_into(d, "compensation-sweep.csv", &ff_logs[0])?;
+        write_into(d, "pressure-hold.csv", &with.log)?;
+        write_into(d, "pressure-hold-no-absorber.csv", &without.log)?;
+        write_into(d, "pressure-step.csv", &stepped.log)?;
+        write_into(d, "speed-step.csv", &sped.log)?;
+        let runs = Runs {
+            with: &with,
+            without: &without,
+            without_ff: &without_ff,
+            stepped: &stepped,
+            sped: &sped,
+        };
+        figures(d, &runs, (&pw, &po), &plant, hold.steady_from_s)
+    })?;
+    outputs.print(&table);
+    outputs.commit()
+}
+
+/// The demo's runs the figures show.
+struct Runs<'a> {
+    with: &'a Run,
+    without: &'a Run,
+    without_ff: &'a Run,
+    stepped: &'a Run,
+    sped: &'a Run,
+}
+
+/// Renders the demo's figures into `d`: the pressure trace, the pulsation spectrum with the
+/// physical orders (`pw`, `po`: the holding's pulsation with and without the absorber),
+/// the pressure step and the speed step.
+fn figures(
+    d: &StagedFolder,
+    r: &Runs,
+    (pw, po): (&super::holding::Pulsation, &super::holding::Pulsation),
+    plant: &Rig,
+    steady_from_s: f64,
+) -> Result<(), CliError> {
+    let plot = |name: &str, fig: Result<Figure, String>| {
+        fig.map_err(|e| CliError::Failed(format!("plot `{name}`: {e}")))?
+            .write_into(d, name)
     };
+    plot(
+        "pressure_trace.svg",
+        pressure_figure(r.with, r.without, r.without_ff, steady_from_s),
+    )?;
     let rev_s = pw.speed_rad_s / (2.0 * std::f64::consts::PI);
-    let srcs = sources(&plant);
+    let srcs = sources(plant);
     let markers: Vec<Marker> = srcs
         .iter()
         .map(|s| Marker {
@@ -281,77 +301,64 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             label: s.cause,
         })
         .collect();
+    let below_150_hz = |p: &super::holding::Pulsation| -> Vec<(f64, f64)> {
+        p.spectrum
+            .iter()
+            .copied()
+            .filter(|(f, _)| *f <= 150.0)
+            .collect()
+    };
     plot(
-        "spectrum",
+        "pulsation_spectrum.svg",
         line_chart(
-            &out.join("pulsation_spectrum.svg"),
             "Pressure pulsation spectrum (true p_A, steady state) with the physical orders",
             "f [Hz]",
             "amplitude [Pa]",
             &[
                 Series {
                     name: "no absorber",
-                    points: po
-                        .spectrum
-                        .iter()
-                        .copied()
-                        .filter(|(f, _)| *f <= 150.0)
-                        .collect(),
+                    points: below_150_hz(po),
                 },
                 Series {
                     name: "absorber fitted",
-                    points: pw
-                        .spectrum
-                        .iter()
-                        .copied()
-                        .filter(|(f, _)| *f <= 150.0)
-                        .collect(),
+                    points: below_150_hz(pw),
                 },
             ],
             &markers,
             true,
         ),
     )?;
+    let stepped = r.stepped;
+    let mpa = |y: &[f64]| -> Vec<(f64, f64)> {
+        stepped
+            .log
+            .t_s
+            .iter()
+            .zip(y)
+            .map(|(t, p)| (*t, p / 1e6))
+            .collect()
+    };
     plot(
-        "step response",
+        "pressure_step.svg",
         line_chart(
-            &out.join("pressure_step.svg"),
             "Pressure step 3 → 5 MPa (blocked cylinder)",
             "t [s]",
             "p [MPa]",
             &[
                 Series {
                     name: "setpoint",
-                    points: stepped
-                        .log
-                        .t_s
-                        .iter()
-                        .zip(&stepped.log.p_ref_pa)
-                        .map(|(t, p)| (*t, p / 1e6))
-                        .collect(),
+                    points: mpa(&stepped.log.p_ref_pa),
                 },
                 Series {
                     name: "true p_A",
-                    points: stepped
-                        .log
-                        .t_s
-                        .iter()
-                        .zip(&stepped.p_true_pa)
-                        .map(|(t, p)| (*t, p / 1e6))
-                        .collect(),
+                    points: mpa(&stepped.p_true_pa),
                 },
             ],
             &[],
             false,
         ),
     )?;
-    speed_figure(&out.join("speed_step.svg"), &sped)?;
-    let _ = writeln!(
-        table,
-        "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, compensation-sweep.csv (the feed-forward's bench sweep), compensation.table, pressure_trace, pulsation_spectrum, pressure_step, speed_step (each .svg and .png)",
-        out.display()
-    );
-    print_stdout(&table)
+    plot("speed_step.svg", speed_figure(r.sped))
 }
 
 /// Seconds of the steady hold the pressure figure shows: enough for the slowest line
@@ -364,12 +371,11 @@ const PRESSURE_FIGURE_S: f64 = 1.2;
 /// what the transducer reads with the absorber fitted (its noise and quantisation are
 /// larger than the absorbed pulsation).
 fn pressure_figure(
-    path: &Path,
     with: &Run,
     without: &Run,
     without_ff: &Run,
     steady_from_s: f64,
-) -> Result<(), CliError> {
+) -> Result<Figure, String> {
     let t_end = with.log.t_s.last().copied().unwrap_or(0.0);
     let t_from = steady_from_s.max(t_end - PRESSURE_FIGURE_S);
     let kpa_about_5mpa = |t: &[f64], p: &[f64]| -> Vec<(f64, f64)> {
@@ -400,7 +406,6 @@ fn pressure_figure(
         points: kpa_about_5mpa(&with.log.t_s, &with.log.p_pa),
     }];
     stacked_chart(
-        path,
         "Port-A pressure holding 5 MPa: the pulsation with and without the absorber",
         "t [s]",
         &[
@@ -408,12 +413,11 @@ fn pressure_figure(
             Panel::new("measured p - 5 MPa [kPa]", &measured).weight(2),
         ],
     )
-    .map_err(|e| CliError::Failed(format!("pressure trace: {e}")))
 }
 
 /// The speed step: reference and true speed above, the q current that drives it beneath,
 /// each on its own scale.
-fn speed_figure(path: &Path, sped: &Run) -> Result<(), CliError> {
+fn speed_figure(sped: &Run) -> Result<Figure, String> {
     let t = &sped.log.t_s;
     let pairs = |y: &[f64]| -> Vec<(f64, f64)> { t.iter().zip(y).map(|(t, y)| (*t, *y)).collect() };
     let speed_ref = sped.log.speed_ref_rad_s.clone().unwrap_or_default();
@@ -432,7 +436,6 @@ fn speed_figure(path: &Path, sped: &Run) -> Result<(), CliError> {
         points: pairs(&sped.log.iq_a),
     }];
     stacked_chart(
-        path,
         "Speed step 0 → 50 rad/s (payload free)",
         "t [s]",
         &[
@@ -440,5 +443,4 @@ fn speed_figure(path: &Path, sped: &Run) -> Result<(), CliError> {
             Panel::new("q current [A]", &current).weight(2),
         ],
     )
-    .map_err(|e| CliError::Failed(format!("speed step: {e}")))
 }

@@ -70,8 +70,9 @@ pub(crate) fn holding_run(
             progress: true,
             metadata,
             compensation: None,
+            integrator: Default::default(),
         },
     )
     .map_err(CliError::Failed)
-    .and_then(super::converged)
+    .and_then(|r| super::converged(r, None))
 }

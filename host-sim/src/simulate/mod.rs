@@ -5,17 +5,16 @@
 pub mod demo;
 pub mod holding;
 
-use crate::bench_log::limits::MAX_ROWS;
-use crate::bench_log::{self, BenchLog, MIN_ROWS};
+use crate::bench_log::{self, MIN_ROWS};
 use crate::output::paths::Declared;
-use crate::output::{print_stdout, write_json, CliError};
+use crate::output::{CliError, Outputs};
 use crate::rig_file;
-use crate::run::{first_unphysical, log_plan, run, Run, RunOptions};
+use crate::run::{first_unphysical, log_plan, most_rows, run, Run, RunOptions, LOGGED_COLUMNS};
 use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::{by_name, PROCEDURES, SCENARIOS};
-use plant_model::effects::EFFECT_NAMES;
-use plant_model::{Effect, Rig};
+use plant_model::effects::{EffectError, EFFECT_NAMES};
+use plant_model::{Effect, Integrator, Rig};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -72,6 +71,28 @@ pub struct SimulateArgs {
     /// Write a run summary as JSON, with the real-time factor (`-`: standard output).
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+    /// The plant's integration scheme: `exponential` (the default: exact winding and
+    /// hydraulic blocks, third-order exponential Adams–Bashforth), `rk4` (classical
+    /// Runge–Kutta at the PWM period, the scheme before it) or `rk4-quarter` (at a quarter of
+    /// the period, the accuracy reference).
+    #[arg(long, value_name = "NAME", default_value = "exponential", value_parser = integrator)]
+    pub integrator: Integrator,
+    /// Also run the same simulation with this scheme (not logged) and report both real-time
+    /// factors and their ratio (per second of the thread's CPU time, so that other work on
+    /// the machine does not bias it), measured in this process (`--json`'s `compared`).
+    #[arg(long, value_name = "NAME", value_parser = integrator)]
+    pub compare_integrator: Option<Integrator>,
+}
+
+/// An integration scheme by name.
+fn integrator(s: &str) -> Result<Integrator, String> {
+    Integrator::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = Integrator::NAMES.iter().map(|(n, _)| *n).collect();
+        format!(
+            "unknown integrator `{s}`: the integrators are {}",
+            names.join(", ")
+        )
+    })
 }
 
 /// A log rate: positive and at most the 20 kHz PWM rate the telemetry is sampled at. [Hz]
@@ -132,16 +153,32 @@ pub fn parse_effect_list(list: &str) -> Result<EffectList, String> {
     }
     specs
         .iter()
-        .map(|spec| {
-            Effect::parse(spec).map_err(|e| {
-                format!(
-                    "effect `{spec}`: {e} (effects: {})",
-                    EFFECT_NAMES.join(", ")
-                )
-            })
-        })
+        .map(|spec| Effect::parse(spec).map_err(|e| effect_error(spec, e)))
         .collect::<Result<Vec<_>, _>>()
         .map(EffectList)
+}
+
+/// The message for a refused effect `spec`: what is wrong, and for a name or parameter
+/// not in the catalogue, the ones that are.
+fn effect_error(spec: &str, e: EffectError) -> String {
+    let known = match e {
+        EffectError::UnknownEffect => format!(" (effects: {})", EFFECT_NAMES.join(", ")),
+        EffectError::UnknownParameter => {
+            let name = spec.split_once(':').map_or(spec, |(n, _)| n).trim();
+            let params: Vec<&str> = Effect::default_for(name)
+                .map(|d| {
+                    d.parameters()
+                        .into_iter()
+                        .flatten()
+                        .map(|(k, _)| k)
+                        .collect()
+                })
+                .unwrap_or_default();
+            format!(" (its parameters: {})", params.join(", "))
+        }
+        _ => String::new(),
+    };
+    format!("effect `{spec}`: {e}{known}")
 }
 
 pub(crate) fn rig_name(rig: &Rig) -> &'static str {
@@ -152,12 +189,15 @@ pub(crate) fn rig_name(rig: &Rig) -> &'static str {
     }
 }
 
-pub(crate) fn effects_text(effects: &[Effect]) -> String {
+/// `effects` as the log's metadata records them: each as it acts on `rig` (every default
+/// stated, [`Effect::resolved`]), `name:param=value,…` joined by `;`.
+pub(crate) fn effects_text(rig: &Rig, effects: &[Effect]) -> String {
     if effects.is_empty() {
         return "none".into();
     }
     effects
         .iter()
+        .map(|e| e.resolved(rig))
         .map(|e| {
             let params: Vec<String> = e
                 .parameters()
@@ -187,19 +227,26 @@ pub(crate) fn plant_rig(rig: &Rig, effects: &[Effect]) -> Result<Rig, CliError> 
 }
 
 /// `run` unless its state left the physical range: a rig the integration cannot follow
-/// (bad input, exit status 2) rather than a log of NaN.
-pub(crate) fn converged(run: Run) -> Result<Run, CliError> {
+/// (bad input, exit status 2) rather than a log of NaN. `rig_file` is the plant's rig file
+/// when one was given (the message points there, else at the rig and effects asked for).
+pub(crate) fn converged(run: Run, rig_file: Option<&Path>) -> Result<Run, CliError> {
     match first_unphysical(&run.log) {
         None => Ok(run),
-        Some((t, name, v)) => Err(CliError::BadInput(format!(
-            "the simulation diverged: `{name}` reached {v:e} at t = {t:.6} s; the rig's \
-             parameters make the model numerically unstable (check the rig file's values)"
-        ))),
+        Some((t, name, v)) => {
+            let check = match rig_file {
+                Some(f) => format!("check the values in the rig file `{}`", f.display()),
+                None => "check the rig's parameters and the effects asked for".into(),
+            };
+            Err(CliError::BadInput(format!(
+                "the simulation diverged: `{name}` reached {v:e} at t = {t:.6} s; the plant's \
+                 parameters make the model numerically unstable ({check})"
+            )))
+        }
     }
 }
 
 /// Checks before a run that `duration_s` [s] at `log_rate_hz` [Hz] gives a bench log of
-/// [`MIN_ROWS`] to [`MAX_ROWS`] rows (`period_s`: the PWM period [s]).
+/// [`MIN_ROWS`] to [`most_rows`] rows (`period_s`: the PWM period [s]).
 fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<(), CliError> {
     let (every, rows) = log_plan(duration_s, log_rate_hz, period_s);
     let rate = 1.0 / (period_s * every as f64);
@@ -208,12 +255,13 @@ fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<
         show(duration_s),
         show(log_rate_hz)
     );
-    if rows > MAX_ROWS as f64 {
+    let most = most_rows();
+    if rows > most as f64 {
         return Err(CliError::BadInput(format!(
-            "{asked} would log {} rows; a bench log holds at most {MAX_ROWS} ({:.0} s at this \
-             rate)",
+            "{asked} would log {} rows; a bench log of its {LOGGED_COLUMNS} columns holds at \
+             most {most} ({:.0} s at this rate)",
             show(rows),
-            MAX_ROWS as f64 / rate
+            most as f64 / rate
         )));
     }
     if rows < MIN_ROWS as f64 {
@@ -221,11 +269,6 @@ fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<
             "{asked} would log {rows} rows; a bench log needs at least {MIN_ROWS}"
         )));
     }
-    Ok(())
-}
-
-pub(crate) fn write_log(path: &Path, log: &BenchLog) -> Result<(), CliError> {
-    bench_log::write(path, log)?;
     Ok(())
 }
 
@@ -240,7 +283,9 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
                 sc.name, sc.duration_s, sc.description
             );
         }
-        return print_stdout(&s);
+        let mut out = Outputs::new();
+        out.print(&s);
+        return out.commit();
     }
     let name = args.scenario.as_deref().unwrap_or_default();
     let scenario = by_name(name).ok_or_else(|| {
@@ -276,10 +321,11 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         .map(|e| e.0.clone())
         .unwrap_or_default();
     // The plant is the controller's rig unless the bench's actuator is given apart.
-    let plant = match &args.plant_rig {
-        Some(path) => plant_rig(&rig_file::load(path)?, &effects)?,
-        None => plant_rig(&controller, &effects)?,
+    let base = match &args.plant_rig {
+        Some(path) => rig_file::load(path)?,
+        None => controller.clone(),
     };
+    let plant = plant_rig(&base, &effects)?;
     let compensation = match &args.compensation {
         Some(path) => Some(crate::compensate::read_table(path, &controller)?),
         None => None,
@@ -292,12 +338,13 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         ("source".into(), "simulation".into()),
         ("rig".into(), rig_name(rig).into()),
         ("scenario".into(), scenario.name.into()),
-        ("effects".into(), effects_text(&effects)),
+        ("effects".into(), effects_text(&base, &effects)),
         (
             "precharge_pa".into(),
             format!("{}", controller.absorber.precharge_pa),
         ),
         ("seed".into(), format!("{seed}")),
+        ("integrator".into(), args.integrator.name().into()),
     ];
     if let Some(path) = &args.plant_rig {
         metadata.push(("plant_rig".into(), path.display().to_string()));
@@ -325,40 +372,78 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             ),
         ));
     }
-    let r = run(
-        &plant,
-        &controller,
-        scenario,
-        &RunOptions {
-            duration_s: duration,
-            log_rate_hz: args.log_rate,
-            seed,
-            progress: true,
-            metadata,
-            compensation,
-        },
-    )
-    .map_err(CliError::Failed)
-    .and_then(converged)?;
-    write_log(out, &r.log)?;
+    let options = RunOptions {
+        duration_s: duration,
+        log_rate_hz: args.log_rate,
+        seed,
+        progress: true,
+        metadata,
+        compensation,
+        integrator: args.integrator,
+    };
+    let r = run(&plant, &controller, scenario, &options)
+        .map_err(CliError::Failed)
+        .and_then(|r| converged(r, args.plant_rig.as_deref()))?;
+    // The same run with the other scheme, for the ratio of their speeds in this process.
+    let compared = match args.compare_integrator {
+        Some(other) => {
+            let o = run(
+                &plant,
+                &controller,
+                scenario,
+                &RunOptions {
+                    integrator: other,
+                    progress: false,
+                    ..options
+                },
+            )
+            .map_err(CliError::Failed)
+            .and_then(|r| converged(r, args.plant_rig.as_deref()))?;
+            Some((other, o))
+        }
+        None => None,
+    };
+    let mut outputs = Outputs::new();
+    bench_log::stage(&mut outputs, "--out", out, &r.log)?;
+    if let Some(json_path) = &args.json {
+        let mut summary = json!({
+            "scenario": scenario.name,
+            "duration_s": duration,
+            "rows": r.log.len(),
+            "out": out.display().to_string(),
+            "real_time_factor": r.real_time_factor,
+            "cpu_real_time_factor": r.cpu_real_time_factor,
+            "integrator": args.integrator.name(),
+        });
+        if let Some((other, o)) = &compared {
+            summary["compared"] = json!({
+                "integrator": other.name(),
+                "real_time_factor": o.real_time_factor,
+                "cpu_real_time_factor": o.cpu_real_time_factor,
+                "speedup": r.cpu_real_time_factor / o.cpu_real_time_factor,
+            });
+        }
+        outputs.json("--json", json_path, &summary)?;
+    }
+    outputs.commit()?;
     eprintln!(
-        "{}: {} rows over {duration} s written to {} ({:.0}× real time)",
+        "{}: {} rows over {duration} s written to {} ({:.0}× real time, {:.0}× per CPU second, \
+         {})",
         scenario.name,
         r.log.len(),
         out.display(),
-        r.real_time_factor
+        r.real_time_factor,
+        r.cpu_real_time_factor,
+        args.integrator.name()
     );
-    if let Some(json_path) = &args.json {
-        write_json(
-            json_path,
-            &json!({
-                "scenario": scenario.name,
-                "duration_s": duration,
-                "rows": r.log.len(),
-                "out": out.display().to_string(),
-                "real_time_factor": r.real_time_factor,
-            }),
-        )?;
+    if let Some((other, o)) = &compared {
+        eprintln!(
+            "{}: {:.0}× per CPU second; {} is {:.2}× as fast",
+            other.name(),
+            o.cpu_real_time_factor,
+            args.integrator.name(),
+            r.cpu_real_time_factor / o.cpu_real_time_factor
+        );
     }
     Ok(())
 }

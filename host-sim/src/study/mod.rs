@@ -6,7 +6,7 @@ pub mod accumulator_design;
 pub mod precharge_sweep;
 
 use crate::output::paths::Declared;
-use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::output::{is_stdout, CliError, Outputs};
 use crate::values::positive_f64;
 use clap::Args;
 use plant_model::Rig;
@@ -34,12 +34,13 @@ impl AccumulatorDesignArgs {
 pub fn run_accumulator_design(rig: &Rig, a: &AccumulatorDesignArgs) -> Result<(), CliError> {
     let design = accumulator_design::design(rig, a.pressure)
         .map_err(|e| CliError::BadInput(e.to_string()))?;
+    let mut out = Outputs::new();
     if let Some(path) = &a.json {
         let value = serde_json::to_value(&design).map_err(|e| CliError::Failed(e.to_string()))?;
-        write_json(path, &value)?;
-        if is_stdout(path) {
-            return Ok(());
-        }
+        out.json("--json", path, &value)?;
     }
-    print_stdout(&design.to_table())
+    if !a.json.as_deref().is_some_and(is_stdout) {
+        out.print(&design.to_table());
+    }
+    out.commit()
 }

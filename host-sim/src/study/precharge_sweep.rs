@@ -3,12 +3,13 @@
 //! steady pulsation of each against the reference, with the absorber's natural frequency
 //! and damping at the run's mean pressure; optionally the runs' bench logs and plots.
 
-use crate::output::paths::{replaceable, Declared};
-use crate::output::{is_stdout, print_stdout, write_json, CliError};
+use crate::bench_log::write_into;
+use crate::output::paths::Declared;
+use crate::output::{is_stdout, CliError, Outputs, StagedFolder};
 use crate::plots::{line_chart, Series};
 use crate::run::Run;
 use crate::simulate::holding::{holding_run, pulsation, Pulsation};
-use crate::simulate::{effects_text, plant_rig, write_log};
+use crate::simulate::{effects_text, plant_rig};
 use crate::values::{positive_f64, show};
 use clap::Args;
 use closed_loop::by_name;
@@ -42,11 +43,24 @@ pub struct SweepPrechargeArgs {
 impl SweepPrechargeArgs {
     /// The files it writes.
     pub fn paths(&self) -> Declared<'_> {
-        Declared::default()
-            .file("--json", self.json.as_ref())
-            .dir("--out", self.out.as_ref())
+        Declared::default().file("--json", self.json.as_ref()).dir(
+            "--out",
+            self.out.as_ref(),
+            FILES,
+        )
     }
 }
+
+/// The files the sweep writes into its folder: a bench log per precharge and the reference
+/// without absorber, the figures as SVG and PNG.
+pub const FILES: &[&str] = &[
+    "precharge-*MPa.csv",
+    "no-absorber.csv",
+    "pressure_traces.svg",
+    "pressure_traces.png",
+    "sweep.svg",
+    "sweep.png",
+];
 
 /// Most precharges one sweep runs.
 pub const MAX_POINTS: usize = 32;
@@ -98,20 +112,6 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
             )));
         }
     }
-    if let Some(dir) = &args.out {
-        // The folder's files, checked before the runs (see `write_sweep_outputs`).
-        let decimals = file_decimals(args.values.iter().copied());
-        let logs = args.values.iter().map(|p0| log_name(*p0, decimals));
-        for name in logs.chain([
-            "no-absorber.csv".into(),
-            "pressure_traces.svg".into(),
-            "sweep.svg".into(),
-            "pressure_traces.png".into(),
-            "sweep.png".into(),
-        ]) {
-            replaceable("--out", &dir.join(name))?;
-        }
-    }
     let effects: Vec<Effect> = paper_low_speed_effects().to_vec();
     let hold =
         by_name("pressure-hold").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
@@ -138,7 +138,7 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
             let meta = vec![
                 ("source".to_string(), "simulation".to_string()),
                 ("scenario".into(), "pressure-hold".into()),
-                ("effects".into(), effects_text(&effects)),
+                ("effects".into(), effects_text(rig, &effects)),
                 (
                     "precharge_pa".into(),
                     p0.map(|p| format!("{p}"))
@@ -197,12 +197,16 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
     table.push_str(
         "\nNatural frequency and damping are the absorber's (inlet inertance against the gas) at the run's mean pressure; 0 where the precharge is at or above it and the absorber holds no oil.\n",
     );
+    let mut out = Outputs::new();
     if let Some(dir) = &args.out {
-        write_sweep_outputs(dir, &ref_run, &points)?;
+        out.folder("--out", dir, FILES, |d| {
+            write_sweep_outputs(d, &ref_run, &points)
+        })?;
         let _ = writeln!(table, "bench logs and plots written to {}/", dir.display());
     }
     if let Some(path) = &args.json {
-        write_json(
+        out.json(
+            "--json",
             path,
             &json!({
                 "points": json_points,
@@ -213,23 +217,20 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
                 "pulsation_signal": "true port-A pressure of the plant",
             }),
         )?;
-        if is_stdout(path) {
-            return Ok(());
-        }
     }
-    print_stdout(&table)
+    if !args.json.as_deref().is_some_and(is_stdout) {
+        out.print(&table);
+    }
+    out.commit()
 }
 
+/// Writes the runs' bench logs and the two figures into the sweep's folder.
 fn write_sweep_outputs(
-    dir: &PathBuf,
+    d: &StagedFolder,
     reference: &Run,
     points: &[(f64, Run, Pulsation)],
 ) -> Result<(), CliError> {
-    std::fs::create_dir_all(dir).map_err(|source| CliError::Write {
-        file: dir.clone(),
-        source,
-    })?;
-    write_log(&dir.join("no-absorber.csv"), &reference.log)?;
+    write_into(d, "no-absorber.csv", &reference.log)?;
     let mut traces = vec![Series {
         name: "no absorber",
         points: window(reference),
@@ -240,38 +241,44 @@ fn write_sweep_outputs(
         .map(|(p0, _, _)| format!("p0 = {:.1} MPa", p0 / 1e6))
         .collect();
     for ((p0, run, _), name) in points.iter().zip(&names) {
-        write_log(&dir.join(log_name(*p0, decimals)), &run.log)?;
+        write_into(d, &log_name(*p0, decimals), &run.log)?;
         traces.push(Series {
             name,
             points: window(run),
         });
     }
-    line_chart(
-        &dir.join("pressure_traces.svg"),
-        "Steady holding pressure per absorber precharge (true p_A)",
-        "t [s]",
-        "p [MPa]",
-        &traces,
-        &[],
-        false,
+    let plot = |name: &str, fig: Result<crate::plots::Figure, String>| {
+        fig.map_err(|e| CliError::Failed(format!("plot `{name}`: {e}")))?
+            .write_into(d, name)
+    };
+    plot(
+        "pressure_traces.svg",
+        line_chart(
+            "Steady holding pressure per absorber precharge (true p_A)",
+            "t [s]",
+            "p [MPa]",
+            &traces,
+            &[],
+            false,
+        ),
+    )?;
+    plot(
+        "sweep.svg",
+        line_chart(
+            "Pulsation peak-to-peak against precharge (holding at 5 MPa)",
+            "precharge [MPa]",
+            "pulsation pp [Pa]",
+            &[Series {
+                name: "with absorber",
+                points: points
+                    .iter()
+                    .map(|(p0, _, p)| (p0 / 1e6, p.pp_pa))
+                    .collect(),
+            }],
+            &[],
+            true,
+        ),
     )
-    .map_err(CliError::Failed)?;
-    line_chart(
-        &dir.join("sweep.svg"),
-        "Pulsation peak-to-peak against precharge (holding at 5 MPa)",
-        "precharge [MPa]",
-        "pulsation pp [Pa]",
-        &[Series {
-            name: "with absorber",
-            points: points
-                .iter()
-                .map(|(p0, _, p)| (p0 / 1e6, p.pp_pa))
-                .collect(),
-        }],
-        &[],
-        true,
-    )
-    .map_err(CliError::Failed)
 }
 
 fn window(r: &Run) -> Vec<(f64, f64)> {

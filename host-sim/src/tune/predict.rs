@@ -59,6 +59,7 @@ impl StepSpec {
             duration_s: self.lead_s + self.after_s,
             steady_from_s: self.lead_s,
             events,
+            profile: None,
         }
     }
 }

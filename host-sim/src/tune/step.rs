@@ -190,6 +190,35 @@ pub fn metrics(t: &[f64], response: &[f64], step: &Step, signal: Signal) -> Step
     }
 }
 
+/// The least part of a step a response must come toward its new setpoint for the step to
+/// be one the loop followed: half (a loop with integral action reaches all of it; a slow
+/// one, at its speed limit, at least half within its window). [1 of the step]
+pub const MIN_FOLLOWED: f64 = 0.5;
+
+/// How far `response` (smoothed as for [`metrics`]) came toward `step.to` within the
+/// step's window, as a part of the step: 0 where it stayed at its value before the step,
+/// 1 where it reached the new setpoint (negative where it went the other way).
+pub fn followed(t: &[f64], response: &[f64], step: &Step, signal: Signal) -> f64 {
+    let width = signal.smoothing_s();
+    let smooth = centred_mean(t, response, width);
+    let size = step.to - step.from;
+    let end = step.end.min(smooth.len());
+    // The value before the step: the last average taken wholly before it.
+    let Some(t0) = t.get(step.start) else {
+        return 0.0;
+    };
+    let last_before = t[..step.start].partition_point(|x| *x <= t0 - 0.5 * width);
+    let Some(&before) = smooth.get(last_before.saturating_sub(1)) else {
+        return 0.0;
+    };
+    smooth
+        .get(step.start..end)
+        .unwrap_or_default()
+        .iter()
+        .map(|y| (y - before) / size)
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
 /// Centred moving average of `y` over `width` seconds (shorter at the ends), by prefix sums.
 pub fn centred_mean(t: &[f64], y: &[f64], width: f64) -> Vec<f64> {
     let n = y.len().min(t.len());
@@ -284,6 +313,26 @@ mod tests {
             find(&t, &vec![5e6; t.len()], Signal::Pressure),
             Err(StepError::NoStep)
         );
+    }
+
+    #[test]
+    fn a_response_that_stays_put_did_not_follow_the_step() {
+        // A first-order response with time constant τ comes 1 − e^(−T/τ) of the way in T.
+        let t = times(4000, 5e-4);
+        let r: Vec<f64> = t.iter().map(|&x| if x > 0.5 { 5e6 } else { 3e6 }).collect();
+        let s = find(&t, &r, Signal::Pressure).unwrap();
+        let tau = 0.1;
+        let y: Vec<f64> = t
+            .iter()
+            .map(|&x| 3e6 + 2e6 * (1.0 - (-(x - 0.5).max(0.0) / tau).exp()))
+            .collect();
+        let reached = 1.0 - (-(t[t.len() - 1] - 0.5) / tau).exp();
+        let f = followed(&t, &y, &s, Signal::Pressure);
+        assert!((f - reached).abs() < 0.01, "{f} vs {reached}");
+        let flat = vec![3e6; t.len()];
+        assert_eq!(followed(&t, &flat, &s, Signal::Pressure), 0.0);
+        let away: Vec<f64> = y.iter().map(|v| 6e6 - v).collect();
+        assert!(followed(&t, &away, &s, Signal::Pressure) < 0.0);
     }
 
     #[test]

@@ -1,14 +1,15 @@
 //! The bench log `eha watch --out` writes as the frames arrive (`contracts/bench-log.md`,
 //! the same columns and number text as `eha ingest`): rows go to a hidden file beside the
 //! log as they come, and [`LiveLog::finish`] puts the metadata (counts known only at the
-//! end) and the header before them in the log itself, atomically. Until then the log's
-//! path holds what it held before (or nothing); a session stopped by Ctrl-C or a stream
-//! that ends is finished the same way, so every frame taken is in the log.
+//! end) and the header before them in the log itself, as the command's one output
+//! ([`Outputs`]). Until then the log's path holds what it held before (or nothing); a
+//! session stopped by Ctrl-C or a stream that ends is finished the same way, so every
+//! frame taken is in the log.
 
-use crate::bench_log::limits::MAX_ROWS;
+use crate::bench_log::limits::max_rows;
 use crate::bench_log::{format_value, MIN_ROWS};
 use crate::ingest::frame_values;
-use crate::output::interrupt;
+use crate::output::{interrupt, CliError, Outputs};
 use firmware::telemetry::{TelemetryFrame, COLUMNS};
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -96,9 +97,10 @@ impl LiveLog {
         &self.path
     }
 
-    /// True once the log holds as many rows as a bench log may ([`MAX_ROWS`]).
+    /// True once the log holds as many rows as a bench log of the telemetry's columns may
+    /// ([`max_rows`]).
     pub fn is_full(&self) -> bool {
-        self.count >= MAX_ROWS
+        self.count >= max_rows(COLUMNS.len())
     }
 
     /// Appends a frame (ignored once the log [`is_full`](Self::is_full)).
@@ -149,7 +151,8 @@ impl LiveLog {
             });
         }
         let rows_path = self.rows_path.clone();
-        crate::output::atomic::write_with(&self.path, |w| {
+        let mut out = Outputs::new();
+        out.file_with("--out", &self.path, |w| {
             for (k, v) in metadata {
                 writeln!(w, "# {k}: {v}")?;
             }
@@ -157,7 +160,11 @@ impl LiveLog {
             io::copy(&mut File::open(&rows_path)?, w)?;
             Ok(())
         })
-        .map_err(|source| self.failed(source))?;
+        .and_then(|()| out.commit())
+        .map_err(|e| match e {
+            CliError::Write { source, .. } => self.failed(source),
+            e => self.failed(io::Error::other(e.to_string())),
+        })?;
         Ok(self.count)
     }
 }

@@ -66,6 +66,7 @@ impl Plant {
             self.inverter
                 .set_u_dc(self.dc_link.voltage(self.t_s + k as f64 * h));
             self.impose(&inputs);
+            let p0 = self.x[ix::PA];
             let mut left = h;
             if let Some(t_break) = self.break_within(h, &inputs) {
                 self.step_with_events(t_break, &inputs);
@@ -76,6 +77,7 @@ impl Plant {
             self.step_with_events(left, &inputs);
             self.advance_fault_path(left, &inputs);
             self.dc_link.advance(h);
+            self.filter_pressure_sensor(p0, h);
             self.after_step(h, &mut inputs);
         }
     }

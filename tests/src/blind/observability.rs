@@ -1,137 +1,35 @@
-//! What the blind suite's generator measures of its own draws, from the truth it knows and
-//! the diagnosis never sees: each hidden effect's signature against the sensor noise, and,
-//! for the lines below the noise per sample (a piston ripple; a dead time without voltage
-//! columns), the most any angle-locked model could gain on the log — the bound below which
-//! a log cannot tell the effect from `none`.
+//! What the generator measures of its own draws, from the truth it knows and the diagnosis
+//! never sees: each hidden effect's signature against the sensor noise, the rule an
+//! independent bench's generator keeps its draws by (`shared/data/foreign-logs-2/`).
+//!
+//! The signature of an effect is the log with it minus the log without it, both free of
+//! sensor noise (the converters' and the encoder's quantisation stay), on the same rig,
+//! controller and test; in a pair, the other effect is present in both. It is measured as
+//! a root-mean-square over the whole log, per logged signal, against that signal's sensor
+//! noise as an engineer estimates it from the log itself ([`noise_rms`]); an effect shows
+//! when its signature is at least [`SHOWN_RATIO`] times the noise on some signal the log
+//! holds.
+//!
+//! A closed loop can take one of two paths where a small difference tips it (the pressure
+//! loop crossing the absorber's precharge chatters or collapses, or not): there any
+//! perturbation, however small, makes a large on-minus-off. So the signature must also
+//! scale with the effect: at half its departure from the rig ([`super::catalogue::halfway`])
+//! it must be between [`HALF_SCALING`] of the full one on the same signal. An effect that
+//! fails either is drawn again.
 
-use super::{Draw, BELOW_NOISE};
+use super::catalogue::halfway;
+use super::Draw;
 use host_sim::bench_log::{BenchLog, Signal};
-use plant_model::pump::ripple_order;
-use plant_model::{Effect, Rig};
 
-/// `rig` with the white noise of every sensor off (quantisation stays).
-fn noise_free(rig: &Rig) -> Rig {
-    let mut r = rig.clone();
-    r.sensors.current.noise_a_rms = 0.0;
-    r.sensors.pressure.noise_pa_rms = 0.0;
-    r.sensors.dc_link.noise_v_rms = 0.0;
-    r
-}
+/// How far above the noise an effect must stand on some logged signal to be kept. [1]
+pub const SHOWN_RATIO: f64 = 5.0;
 
-/// Root-mean-square of `a − b` over the rows with `t ≥ t_from`.
-fn rms_difference(t: &[f64], a: &[f64], b: &[f64], t_from: f64) -> f64 {
-    let (sum, n) = t
-        .iter()
-        .zip(a.iter().zip(b))
-        .filter(|(t, _)| **t >= t_from)
-        .fold((0.0, 0usize), |(s, n), (_, (x, y))| {
-            (s + (x - y) * (x - y), n + 1)
-        });
-    (sum / n.max(1) as f64).sqrt()
-}
-
-/// One signal's signature of an effect in a closed-loop log.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Signature {
-    /// RMS of (with effect − without), both noise-free: the effect's own trace. [unit]
-    pub effect_rms: f64,
-    /// RMS noise of the signal: RMS of the difference of two effect-free runs with
-    /// different noise seeds, over √2. [unit]
-    pub noise_rms: f64,
-    /// Standard deviation of the signal in the truth log (what the fit measure divides
-    /// by). [unit]
-    pub spread: f64,
-}
-
-impl Signature {
-    /// Effect over noise. [1]
-    pub fn ratio(&self) -> f64 {
-        self.effect_rms / self.noise_rms.max(f64::MIN_POSITIVE)
-    }
-
-    /// The most the fit percentage 100·(1 − ‖y − ŷ‖/‖y − ȳ‖) can gain when a model that
-    /// misses the effect (error ≈ effect + noise) is replaced by one that has it (error ≈
-    /// noise). [percentage points]
-    pub fn attainable_fit_gain(&self) -> f64 {
-        let e = self.effect_rms;
-        let n = self.noise_rms;
-        100.0 * ((e * e + n * n).sqrt() - n) / self.spread.max(f64::MIN_POSITIVE)
-    }
-}
-
-/// The signature of `draw`'s effect on `signal`, measured after `t_from` [s]: the
-/// noise-free truth log against the noise-free log of the same plant without the effect
-/// (the ADCs' and encoder's quantisation stay); the noise from two noisy effect-free runs
-/// with different noise seeds.
-pub fn signature(d: &Draw, signal: Signal, t_from: f64) -> Result<Signature, String> {
-    let with = d.run(&noise_free(&d.truth_rig()), d.noise_seed)?;
-    let without = d.run(&noise_free(&d.tolerance_rig), d.noise_seed)?;
-    let noisy = d.run(&d.tolerance_rig, d.noise_seed)?;
-    let truth = d.run(&d.truth_rig(), d.noise_seed)?;
-    let other = d.run(&d.tolerance_rig, d.noise_seed ^ 0x9e37_79b9_7f4a_7c15)?;
-    let col = |l: &BenchLog| -> Result<Vec<f64>, String> {
-        l.column(signal)
-            .map(<[f64]>::to_vec)
-            .ok_or_else(|| format!("column {} not logged", signal.name()))
-    };
-    let (w, wo, n, o) = (col(&with)?, col(&without)?, col(&noisy)?, col(&other)?);
-    let y = col(&truth)?;
-    let (sum, rows) = truth
-        .t_s
-        .iter()
-        .zip(&y)
-        .filter(|(t, _)| **t >= t_from)
-        .fold((0.0, 0usize), |(s, n), (_, y)| (s + y, n + 1));
-    let mean = vec![sum / rows.max(1) as f64; y.len()];
-    Ok(Signature {
-        effect_rms: rms_difference(&with.t_s, &w, &wo, t_from),
-        noise_rms: rms_difference(&with.t_s, &n, &o, t_from) / 2f64.sqrt(),
-        spread: rms_difference(&truth.t_s, &y, &mean, t_from),
-    })
-}
-
-/// Whether `d` hides a line below the noise per sample: a piston ripple (always), or a dead
-/// time whose log has no voltages (its current lines at 6·p_n are a fraction of the
-/// current's noise per sample at the low end of its range). Such a draw is judged by
-/// [`line_fit_bound`], not by its per-sample signature.
-pub fn line_below_noise(d: &Draw) -> bool {
-    BELOW_NOISE.contains(&d.truth.effect_name)
-        || (d.truth.effect_name == "dead_time" && d.truth.signal != Signal::Uq.name())
-}
-
-/// For a draw of [`line_below_noise`], the most a model with the line could gain on the
-/// truth's signal or the speed over the log's second half ([`angle_locked_fit_bound`] at the line's
-/// orders: the ripple's harmonics, or 6·p_n and 12·p_n for a dead time); `None` for any
-/// other draw. When it is below the suite's 10 points, this log does not tell the effect
-/// from `none` at the suite's standard. [percentage points]
-pub fn line_fit_bound(d: &Draw) -> Result<Option<f64>, String> {
-    if !line_below_noise(d) {
-        return Ok(None);
-    }
-    let orders = match d.effect {
-        Effect::PistonRipple { pistons, .. } => ripple_orders(pistons),
-        _ => {
-            let p = d.tolerance_rig.motor.pole_pairs;
-            vec![6 * p, 12 * p]
-        }
-    };
-    let signal = Signal::from_name(d.truth.signal)
-        .ok_or_else(|| format!("{} is not a bench-log column", d.truth.signal))?;
-    // A torque line shows in the q current and, as far as the speed loop lets it through,
-    // in the speed: the better of the two (which one depends on the controller's tuning).
-    let bound = angle_locked_fit_bound(
-        d,
-        &[signal, Signal::Speed],
-        d.truth.duration_s / 2.0,
-        &orders,
-    )?;
-    Ok(bound.into_iter().reduce(f64::max))
-}
-
-/// Every logged signal a diagnosis is scored on (`fit_percent_by_signal` and the voltages
-/// and d current the subsystem replays predict).
-pub const LOGGED: [Signal; 6] = [
+/// The signals a signature is measured on: every measured column of a bench log (the
+/// references and the shaft angle are the drive's own, not measurements).
+pub const MEASURED: [Signal; 8] = [
     Signal::Pressure,
+    Signal::PressureLow,
+    Signal::PistonPosition,
     Signal::Speed,
     Signal::Iq,
     Signal::Id,
@@ -139,65 +37,167 @@ pub const LOGGED: [Signal; 6] = [
     Signal::Uq,
 ];
 
-/// Harmonics of the piston ripple's fundamental an angle-locked bound fits (the kinematic
-/// shape's cusps put nearly all of its power in the first few).
-pub const RIPPLE_HARMONICS: u32 = 4;
+/// How one hidden effect shows on one signal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shown {
+    /// The logged signal.
+    pub signal: Signal,
+    /// The signature over the noise. [1]
+    pub ratio: f64,
+    /// The signature at half the effect's departure over the full one (NaN when not
+    /// measured). [1]
+    pub half_over_full: f64,
+}
 
-/// The orders (cycles per shaft revolution) of a `z`-piston pump's ripple up to
-/// [`RIPPLE_HARMONICS`].
-pub fn ripple_orders(z: u32) -> Vec<u32> {
-    (1..=RIPPLE_HARMONICS)
-        .map(|k| k * ripple_order(z))
+impl Shown {
+    /// Whether it stands [`SHOWN_RATIO`] above the noise and scales with its effect
+    /// ([`HALF_SCALING`]).
+    pub fn accepted(&self) -> bool {
+        self.ratio >= SHOWN_RATIO
+            && (HALF_SCALING.0..=HALF_SCALING.1).contains(&self.half_over_full)
+    }
+}
+
+/// Range of the half-strength signature over the full one, on one signal, for a signature
+/// that scales with its effect (0.5 where it is proportional). [1]
+pub const HALF_SCALING: (f64, f64) = (0.25, 0.75);
+
+/// Root-mean-square of `a − b`.
+fn rms_difference(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()).max(1);
+    let sum: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
+    (sum / n as f64).sqrt()
+}
+
+/// The signals `log` holds among [`MEASURED`], with their columns.
+fn logged(log: &BenchLog) -> Vec<(Signal, &[f64])> {
+    MEASURED
+        .iter()
+        .filter_map(|&s| log.column(s).map(|c| (s, c)))
         .collect()
 }
 
-/// The most a model could gain on each of `signals` after `t_from` by adding, to a PERFECT
-/// effect-free model of the drawn rig (its exact tolerances, noise-free), any periodic
-/// function of the logged shaft angle at `orders` (cycles per revolution): the function is
-/// fitted by least squares to the very rows it is scored on, so this is an upper bound on
-/// what any angle-locked extension can gain on a validation segment, for any parameters of
-/// it. [percentage points, per signal]
-pub fn angle_locked_fit_bound(
-    d: &Draw,
-    signals: &[Signal],
-    t_from: f64,
-    orders: &[u32],
-) -> Result<Vec<f64>, String> {
-    let truth = d.run(&d.truth_rig(), d.noise_seed)?;
-    let perfect = d.run(&noise_free(&d.tolerance_rig), d.noise_seed)?;
-    let theta = truth
-        .theta_m_rad
-        .as_deref()
-        .ok_or("the shaft angle is not logged")?;
-    let rows: Vec<usize> = (0..truth.t_s.len())
-        .filter(|&i| truth.t_s[i] >= t_from && i < perfect.t_s.len())
+/// The RMS of the white noise on `y`, from its second differences (which take out any
+/// motion slower than a few samples; their variance is 6σ² for white noise): the median
+/// absolute second difference, made a standard deviation by 1.4826 (robust to the steps
+/// and transients of the test), over √6; a quantised signal whose second differences are
+/// mostly zero falls back to their RMS over √6. Never below the quantisation noise of the
+/// signal's smallest step, step/√12; differences below 1e-9 of the signal's magnitude are
+/// rounding, not noise. [unit of `y`]
+pub fn noise_rms(y: &[f64]) -> f64 {
+    let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let eps = 1e-9 * scale;
+    let clean = |d: f64| if d.abs() > eps { d.abs() } else { 0.0 };
+    let step = y
+        .windows(2)
+        .map(|w| clean(w[1] - w[0]))
+        .filter(|d| *d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let mut d2: Vec<f64> = y
+        .windows(3)
+        .map(|w| clean(w[2] - 2.0 * w[1] + w[0]))
         .collect();
-    let basis = nalgebra::DMatrix::from_fn(rows.len(), 2 * orders.len(), |r, c| {
-        let phase = f64::from(orders[c / 2]) * theta[rows[r]];
-        if c % 2 == 0 {
-            phase.cos()
-        } else {
-            phase.sin()
-        }
-    });
-    let svd = basis.clone().svd(true, true);
-    signals
-        .iter()
-        .map(|&signal| {
-            let missing = || format!("column {} not logged", signal.name());
-            let y = truth.column(signal).ok_or_else(missing)?;
-            let m = perfect.column(signal).ok_or_else(missing)?;
-            let residual =
-                nalgebra::DVector::from_iterator(rows.len(), rows.iter().map(|&i| y[i] - m[i]));
-            let coefficients = svd.solve(&residual, 1e-12)?;
-            let left = &residual - &basis * coefficients;
-            let mean = rows.iter().map(|&i| y[i]).sum::<f64>() / rows.len().max(1) as f64;
-            let spread = rows
-                .iter()
-                .map(|&i| (y[i] - mean).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            Ok(100.0 * (residual.norm() - left.norm()) / spread.max(f64::MIN_POSITIVE))
-        })
+    if d2.is_empty() || !step.is_finite() {
+        return 0.0;
+    }
+    let rms = (d2.iter().map(|d| d * d).sum::<f64>() / d2.len() as f64).sqrt();
+    let mid = d2.len() / 2;
+    let (_, median, _) = d2.select_nth_unstable_by(mid, f64::total_cmp);
+    let sigma = if *median > 0.0 { 1.4826 * *median } else { rms };
+    (sigma / 6f64.sqrt()).max(step / 12f64.sqrt())
+}
+
+/// The sensor noise of each signal `log` holds among [`MEASURED`] ([`noise_rms`]); a signal
+/// without noise (a blocked piston's position) is left out. [unit]
+pub fn noise_by_signal(log: &BenchLog) -> Vec<(Signal, f64)> {
+    logged(log)
+        .into_iter()
+        .map(|(s, y)| (s, noise_rms(y)))
+        .filter(|(_, n)| *n > 0.0)
         .collect()
+}
+
+/// Where the effect whose signature is `with − without` shows, against `noise`: the
+/// accepted signal ([`Shown::accepted`]) of the largest ratio, or, when none is, the signal
+/// of the largest ratio (`None` when no signal has noise). `half` is the log at half the
+/// effect (`None`: not measured).
+pub fn shown(
+    with: &BenchLog,
+    without: &BenchLog,
+    half: Option<&BenchLog>,
+    noise: &[(Signal, f64)],
+) -> Option<Shown> {
+    let table: Vec<Shown> = noise
+        .iter()
+        .filter_map(|&(s, n)| {
+            let (w, wo) = (with.column(s)?, without.column(s)?);
+            let full = rms_difference(w, wo);
+            let half_over_full = half.and_then(|h| h.column(s)).map_or(f64::NAN, |h| {
+                rms_difference(h, wo) / full.max(f64::MIN_POSITIVE)
+            });
+            Some(Shown {
+                signal: s,
+                ratio: full / n,
+                half_over_full,
+            })
+        })
+        .collect();
+    let largest = |it: &mut dyn Iterator<Item = &Shown>| {
+        it.max_by(|a, b| a.ratio.total_cmp(&b.ratio)).copied()
+    };
+    largest(&mut table.iter().filter(|s| s.accepted())).or_else(|| largest(&mut table.iter()))
+}
+
+/// What the check of one draw measured and produced.
+#[derive(Clone, Debug)]
+pub struct Checked {
+    /// The log the bench records: the truth rig, with noise, every column (the draw's
+    /// dropped columns are taken out when it is written).
+    pub log: BenchLog,
+    /// Per hidden effect, in the draw's order: where it shows.
+    pub shown: Vec<Shown>,
+    /// The sensor noise of each logged signal. [unit]
+    pub noise: Vec<(Signal, f64)>,
+}
+
+impl Checked {
+    /// Whether every hidden effect is accepted.
+    pub fn every_effect_shows(&self) -> bool {
+        self.shown.iter().all(Shown::accepted)
+    }
+}
+
+/// Runs `d` with each of its effects, without it and at half of it, and measures where each
+/// shows; the signals counted are those the written log keeps (not the draw's dropped
+/// columns). One noisy run (the log) and 1 + 2·(number of effects) noise-free runs; a
+/// draw hiding nothing runs once.
+pub fn check(d: &Draw) -> Result<Checked, String> {
+    let truth = d.truth_rig();
+    let log = d.log(&truth, Some(d.noise_seed))?;
+    if d.effects.is_empty() {
+        return Ok(Checked {
+            log,
+            shown: Vec::new(),
+            noise: Vec::new(),
+        });
+    }
+    let mut kept = log.clone();
+    d.structure.drop_columns(&mut kept);
+    let noise = noise_by_signal(&kept);
+    let clean = d.log(&truth, None)?;
+    let mut shown_by_effect = Vec::with_capacity(d.effects.len());
+    for (k, effect) in d.effects.iter().enumerate() {
+        let without_rig = d.rig_without(k);
+        let without = d.log(&without_rig, None)?;
+        let mut half_rig = without_rig.clone();
+        halfway(effect, &without_rig).apply(&mut half_rig);
+        let half = d.log(&half_rig, None)?;
+        let s = shown(&clean, &without, Some(&half), &noise).ok_or("no logged signal has noise")?;
+        shown_by_effect.push(s);
+    }
+    Ok(Checked {
+        log,
+        shown: shown_by_effect,
+        noise,
+    })
 }

@@ -1,0 +1,387 @@
+//! The winding step of the exponential integrator: the currents over a step by the series
+//! of [`super::blocks`], with the torque, its moment, the input power and the copper loss
+//! integrated by Simpson's rule along them, the step cut where the series would converge
+//! slowly and where a phase current crosses the edge of the dead time's band (eq. 2, 5, 17–19;
+//! the dead time as in [`crate::inverter`]).
+
+use super::super::{ix, AngleTerms, Plant, Vector, EVENT_REFINEMENTS, EVENT_TOLERANCE};
+use super::blocks::{mv, winding_series, Winding, WindingStart, M2};
+use super::rates::Rates;
+use super::Poly;
+use crate::inverter::{dq_to_abc, pole_to_dq};
+use crate::motor::Phasor;
+
+/// √3.
+const SQRT3: f64 = 1.732_050_807_568_877_2;
+
+/// Sub-intervals of the winding series are cut so that ν·τ stays at or below this.
+const WINDING_SPAN: f64 = 0.5;
+
+/// Most sub-intervals of the winding series in one segment (a rig far beyond any motor).
+const MAX_WINDING_PIECES: f64 = 1e6;
+
+/// Most pieces the dead time's band crossings cut from one segment.
+const MAX_BAND_CUTS: u32 = 12;
+
+impl Plant {
+    /// The winding currents over `tau` from `x0` with the bridge's `duties` held and the
+    /// shaft's acceleration `shaft`, and Simpson's integrals of the torque, its moment
+    /// ∫(τ − t)·T dt, the input power and the copper loss. The step is cut into pieces where
+    /// the series would converge slowly (ν·δ ≤ ½) and where a phase current crosses the edge
+    /// of the dead time's band (located by regula falsi on the series), so each piece holds
+    /// one linear law of the dead time.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn winding_step(
+        &self,
+        x0: &Vector,
+        at: &AngleTerms,
+        g0: &Rates,
+        poly: &Poly,
+        duties: &[f64; 3],
+        shaft: &Shaft,
+        tau: f64,
+    ) -> WindingOut {
+        let m = &self.motor;
+        let (g1, g2) = (&poly.g1, &poly.g2);
+        let p = m.pole_pairs;
+        let f = &at.flux;
+        let dl = m.l_d_h - m.l_q_h;
+        let wc = &self.exp.winding;
+        let (inv_l, coupling) = (wc.inv_l, wc.coupling);
+        let ideal = self.inverter.pole_voltages_ideal(duties);
+        let dead = self.inverter.has_dead_time();
+        let speed = libm::fabs(p * x0[ix::OMEGA]) + libm::fabs(shaft.alpha_e) * tau;
+        if !dead && (wc.nu_r + speed * wc.nu_w) * tau <= WINDING_SPAN {
+            return self.winding_step_plain(x0, at, g0, poly, &ideal, shaft, tau);
+        }
+        let band = self.inverter.band();
+        // Torque, input power and copper loss with currents i, voltage u and the band's
+        // resistance r·G (turned by `within` since it was taken), the rotor turned by dth
+        // (electrical) since the step's start.
+        let point = |dth: f64, i: [f64; 2], u: [f64; 2], rg: &(M2, M2), within: f64| {
+            // The flux along the angle to second order (its harmonics turn up to ≈ 0.1 rad
+            // per step at the nominal rig's top speed).
+            let psi_d = f.d_wb + dth * (f.d_slope_wb + 0.5 * dth * f.d_curvature_wb);
+            let psi_q = f.q_wb + dth * (f.q_slope_wb + 0.5 * dth * f.q_curvature_wb);
+            let slope_d = f.d_slope_wb + dth * f.d_curvature_wb;
+            let slope_q = f.q_slope_wb + dth * f.q_curvature_wb;
+            let torque = 1.5
+                * p
+                * (psi_d * i[1] - psi_q * i[0]
+                    + i[0] * slope_d
+                    + i[1] * slope_q
+                    + dl * i[0] * i[1]);
+            let v0 = mv(&rg.0, i);
+            let v1 = mv(&rg.1, i);
+            let v = [v0[0] + within * v1[0], v0[1] + within * v1[1]];
+            let power = 1.5 * ((u[0] - v[0]) * i[0] + (u[1] - v[1]) * i[1]);
+            let copper = 1.5 * m.r_s_ohm * (i[0] * i[0] + i[1] * i[1]);
+            (torque, power, copper)
+        };
+        // The dead time at a piece's start (rotor phasor `e`, currents `i`): the voltage in
+        // the rotor frame with the out-of-band drops, the band's resistance r·G and its
+        // derivative in the angle r·G' (G = ⅔·Σ c_k·c_kᵀ over the phases inside it, c_k
+        // phase k's row of d-q → abc, c_k' = (c_k,q, −c_k,d)) and which side of the band each
+        // phase is on.
+        let law = |e: Phasor, i: [f64; 2]| {
+            let i_abc = dq_to_abc(i[0], i[1], e.sin, e.cos);
+            let mut poles = ideal;
+            let mut rg = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+            let mut inside = [false; 3];
+            if dead {
+                let (drop, slope) = self.inverter.dead_time_parts(&i_abc);
+                let rows = phase_rows(e);
+                for k in 0..3 {
+                    poles[k] -= drop[k];
+                    inside[k] = libm::fabs(i_abc[k]) < band;
+                    if inside[k] {
+                        let (c, d) = (rows[k], [rows[k][1], -rows[k][0]]);
+                        let g = slope * 2.0 / 3.0;
+                        for r in 0..2 {
+                            for col in 0..2 {
+                                rg.0[r][col] += g * c[r] * c[col];
+                                rg.1[r][col] += g * (d[r] * c[col] + c[r] * d[col]);
+                            }
+                        }
+                    }
+                }
+            }
+            let (ud, uq) = pole_to_dq(&poles, e.sin, e.cos);
+            ([ud, uq], rg, inside)
+        };
+        // How far the watched phases are from changing side, positive until one does (a
+        // phase that starts a piece on the band's edge has just crossed it and is not watched
+        // in that piece).
+        let margins = |e: Phasor, i: [f64; 2], inside: &[bool; 3]| {
+            let i_abc = dq_to_abc(i[0], i[1], e.sin, e.cos);
+            let mut m = [0.0; 3];
+            for k in 0..3 {
+                let d = (libm::fabs(i_abc[k]) - band) / band;
+                m[k] = if inside[k] { -d } else { d };
+            }
+            m
+        };
+        let margin = |m: [f64; 3], watched: &[bool; 3]| {
+            (0..3)
+                .filter(|k| watched[*k])
+                .map(|k| m[k])
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut out = WindingOut::default();
+        let mut i = [x0[ix::ID], x0[ix::IQ]];
+        let (mut omega_e, mut alpha_e) = (p * x0[ix::OMEGA], shaft.alpha_e);
+        let (mut t0, mut turned) = (0.0, 0.0);
+        out.omega_e_mid = omega_e;
+        let mut first = None;
+        // Band crossings cut at most this many pieces from a step (a current hovering at
+        // the band's edge takes the rest whole).
+        let mut cuts = MAX_BAND_CUTS;
+        while t0 < tau {
+            let e = at.rot_e * Phasor::small(turned);
+            let (u, rg, inside) = law(e, i);
+            if first.is_none() {
+                first = Some(point(turned, i, u, &rg, 0.0));
+            }
+            let start = WindingStart {
+                i,
+                u,
+                omega_e,
+                alpha_e,
+                accel_gain: shaft.gain,
+                accel_load: [shaft.load[0] + 2.0 * t0 * shaft.load[1], shaft.load[1]],
+                emf: [
+                    [
+                        g0.emf[0] + t0 * (g1.emf[0] + t0 * g2.emf[0]),
+                        g0.emf[1] + t0 * (g1.emf[1] + t0 * g2.emf[1]),
+                    ],
+                    [
+                        g1.emf[0] + 2.0 * t0 * g2.emf[0],
+                        g1.emf[1] + 2.0 * t0 * g2.emf[1],
+                    ],
+                    g2.emf,
+                ],
+            };
+            let w = Winding {
+                a: [
+                    [
+                        -m.r_s_ohm * inv_l[0] - inv_l[0] * rg.0[0][0],
+                        omega_e * coupling[0] - inv_l[0] * rg.0[0][1],
+                    ],
+                    [
+                        omega_e * coupling[1] - inv_l[1] * rg.0[1][0],
+                        -m.r_s_ohm * inv_l[1] - inv_l[1] * rg.0[1][1],
+                    ],
+                ],
+                a1: [
+                    [
+                        -inv_l[0] * rg.1[0][0] * omega_e,
+                        -inv_l[0] * rg.1[0][1] * omega_e,
+                    ],
+                    [
+                        -inv_l[1] * rg.1[1][0] * omega_e,
+                        -inv_l[1] * rg.1[1][1] * omega_e,
+                    ],
+                ],
+                coupling,
+                inv_l,
+            };
+            let speed = libm::fabs(omega_e) + libm::fabs(alpha_e) * (tau - t0);
+            let nu = wc.nu_r + speed * wc.nu_w;
+            let left = tau - t0;
+            let mut delta = left
+                .min(WINDING_SPAN / nu.max(1e-300))
+                .max(tau / MAX_WINDING_PIECES);
+            let mut pts = winding_series(&w, &start, delta);
+            if dead && cuts > 0 {
+                let start_m = margins(e, i, &inside);
+                let watched = start_m.map(|m| m > 0.0);
+                let end = e * Phasor::small(pts.turned[1]);
+                let m1 = margin(margins(end, pts.i[1], &inside), &watched);
+                let m0 = margin(start_m, &watched);
+                if m1 <= 0.0 {
+                    // A phase changes side within the piece: cut it just past the crossing.
+                    let (mut lo, mut hi) = ((0.0, m0), (1.0, m1));
+                    let mut kept = 0i8;
+                    let mut fr = m0 / (m0 - m1);
+                    for _ in 0..EVENT_REFINEMENTS {
+                        if hi.0 - lo.0 <= EVENT_TOLERANCE {
+                            break;
+                        }
+                        let trial = winding_series(&w, &start, fr * delta);
+                        let turned_e = e * Phasor::small(trial.turned[1]);
+                        let v = margin(margins(turned_e, trial.i[1], &inside), &watched);
+                        if v > 0.0 {
+                            lo = (fr, v);
+                            kept = if kept > 0 { kept + 1 } else { 1 };
+                            if kept > 1 {
+                                hi.1 *= 0.5;
+                            }
+                        } else {
+                            hi = (fr, v);
+                            kept = if kept < 0 { kept - 1 } else { -1 };
+                            if kept < -1 {
+                                lo.1 *= 0.5;
+                            }
+                        }
+                        fr = lo.0 + (hi.0 - lo.0) * lo.1 / (lo.1 - hi.1);
+                    }
+                    if hi.0 < 1.0 {
+                        delta *= hi.0;
+                        pts = winding_series(&w, &start, delta);
+                        cuts -= 1;
+                    }
+                }
+            }
+            let Some(f0) = first else { break };
+            let mid = point(
+                turned + pts.turned[0],
+                pts.i[0],
+                pts.u[0],
+                &rg,
+                pts.turned[0],
+            );
+            let end = point(
+                turned + pts.turned[1],
+                pts.i[1],
+                pts.u[1],
+                &rg,
+                pts.turned[1],
+            );
+            let k = delta / 6.0;
+            out.torque += k * (f0.0 + 4.0 * mid.0 + end.0);
+            out.torque_moment += k
+                * ((tau - t0) * f0.0
+                    + 4.0 * (tau - t0 - 0.5 * delta) * mid.0
+                    + (tau - t0 - delta) * end.0);
+            out.e_in += k * (f0.1 + 4.0 * mid.1 + end.1);
+            out.e_cu += k * (f0.2 + 4.0 * mid.2 + end.2);
+            // The speed at the step's middle, from the piece holding it.
+            let t1 = if delta >= left { tau } else { t0 + delta };
+            if t0 <= 0.5 * tau && 0.5 * tau <= t1 {
+                let frac = (0.5 * tau - t0) / delta;
+                out.omega_e_mid = pts.omega_e_mid + (frac - 0.5) * (pts.omega_e - omega_e);
+            }
+            i = pts.i[1];
+            omega_e = pts.omega_e;
+            alpha_e = pts.alpha_e;
+            turned += pts.turned[1];
+            // The end's values open the next piece (recomputed there with its own law).
+            first = None;
+            t0 = t1;
+        }
+        out.i = i;
+        out
+    }
+}
+
+impl Plant {
+    /// [`Plant::winding_step`] without dead time, in one piece: the series once, Simpson's
+    /// rule on its start, middle and end.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn winding_step_plain(
+        &self,
+        x0: &Vector,
+        at: &AngleTerms,
+        g0: &Rates,
+        poly: &Poly,
+        poles: &[f64; 3],
+        shaft: &Shaft,
+        tau: f64,
+    ) -> WindingOut {
+        let m = &self.motor;
+        let wc = &self.exp.winding;
+        let (g1, g2) = (&poly.g1, &poly.g2);
+        let p = m.pole_pairs;
+        let f = &at.flux;
+        let (ud, uq) = pole_to_dq(poles, at.rot_e.sin, at.rot_e.cos);
+        let i0 = [x0[ix::ID], x0[ix::IQ]];
+        let omega_e = p * x0[ix::OMEGA];
+        let w = Winding {
+            a: [
+                [wc.decay[0], omega_e * wc.coupling[0]],
+                [omega_e * wc.coupling[1], wc.decay[1]],
+            ],
+            a1: [[0.0; 2]; 2],
+            coupling: wc.coupling,
+            inv_l: wc.inv_l,
+        };
+        let start = WindingStart {
+            i: i0,
+            u: [ud, uq],
+            omega_e,
+            alpha_e: shaft.alpha_e,
+            accel_gain: shaft.gain,
+            accel_load: shaft.load,
+            emf: [g0.emf, g1.emf, g2.emf],
+        };
+        let pts = winding_series(&w, &start, tau);
+        let dl = m.l_d_h - m.l_q_h;
+        let harmonic = f.d_slope_wb != 0.0 || f.q_slope_wb != 0.0;
+        let point = |dth: f64, i: [f64; 2], u: [f64; 2]| {
+            let torque = if harmonic {
+                let psi_d = f.d_wb + dth * (f.d_slope_wb + 0.5 * dth * f.d_curvature_wb);
+                let psi_q = f.q_wb + dth * (f.q_slope_wb + 0.5 * dth * f.q_curvature_wb);
+                let slope_d = f.d_slope_wb + dth * f.d_curvature_wb;
+                let slope_q = f.q_slope_wb + dth * f.q_curvature_wb;
+                psi_d * i[1] - psi_q * i[0] + i[0] * slope_d + i[1] * slope_q + dl * i[0] * i[1]
+            } else {
+                f.d_wb * i[1] - f.q_wb * i[0] + dl * i[0] * i[1]
+            };
+            let power = u[0] * i[0] + u[1] * i[1];
+            let copper = i[0] * i[0] + i[1] * i[1];
+            (torque, power, copper)
+        };
+        let a = point(0.0, i0, [ud, uq]);
+        let b = point(pts.turned[0], pts.i[0], pts.u[0]);
+        let c = point(pts.turned[1], pts.i[1], pts.u[1]);
+        let k = tau / 6.0;
+        let kt = 1.5 * p * k;
+        WindingOut {
+            i: pts.i[1],
+            torque: kt * (a.0 + 4.0 * b.0 + c.0),
+            torque_moment: kt * tau * (a.0 + 2.0 * b.0),
+            e_in: 1.5 * k * (a.1 + 4.0 * b.1 + c.1),
+            e_cu: 1.5 * m.r_s_ohm * k * (a.2 + 4.0 * b.2 + c.2),
+            omega_e_mid: pts.omega_e_mid,
+        }
+    }
+}
+
+/// Rows of the d-q → abc transform at the electrical-angle phasor `e`: phase k's current is
+/// c_k · (i_d, i_q).
+fn phase_rows(e: Phasor) -> [[f64; 2]; 3] {
+    let half = 0.5 * SQRT3;
+    let (s, c) = (e.sin, e.cos);
+    [
+        [c, -s],
+        [-0.5 * c + half * s, 0.5 * s + half * c],
+        [-0.5 * c - half * s, 0.5 * s - half * c],
+    ]
+}
+
+/// The shaft as the winding series sees it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Shaft {
+    /// Electrical acceleration at the start. [rad/s²]
+    pub(super) alpha_e: f64,
+    /// Electrical acceleration per ampere of i_d, i_q. [rad/s²/A]
+    pub(super) gain: [f64; 2],
+    /// The load's electrical acceleration slope and curvature. [rad/s³], [rad/s⁴]
+    pub(super) load: [f64; 2],
+}
+
+/// What [`Plant::winding_step`] gives.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct WindingOut {
+    /// Currents at the end. [A]
+    pub(super) i: [f64; 2],
+    /// ∫T_e dt [N·m·s] and ∫(τ − t)·T_e dt [N·m·s²].
+    pub(super) torque: f64,
+    pub(super) torque_moment: f64,
+    /// Input energy and copper loss. [J]
+    pub(super) e_in: f64,
+    pub(super) e_cu: f64,
+    /// Electrical speed at the middle of the step. [rad/s]
+    pub(super) omega_e_mid: f64,
+}
