@@ -10,6 +10,7 @@
 use crate::commission::CommissionArgs;
 use crate::compensate::CompensateArgs;
 use crate::diagnose::command::DiagnoseArgs;
+use crate::fleet::FleetArgs;
 use crate::ingest::IngestArgs;
 use crate::output::paths::{self, Declared};
 use crate::output::{interrupt, CliError};
@@ -65,6 +66,9 @@ pub enum Command {
     /// Learn the angle-indexed torque feed-forward from bench logs: table, CAN frames,
     /// predicted pulsation.
     Compensate(CompensateArgs),
+    /// Diagnose many bench logs on all cores, resumably: one table, each drive's trends
+    /// and the dates its parameters cross their limits.
+    Fleet(FleetArgs),
 }
 
 /// Parses the process's arguments, runs, reports; the binary's whole `main`.
@@ -118,6 +122,7 @@ impl Command {
             Command::Watch(a) => a.paths(),
             Command::Diagnose(a) => a.paths(),
             Command::Compensate(a) => a.paths(),
+            Command::Fleet(a) => a.paths(),
         }
     }
 }
@@ -142,6 +147,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Watch(a) => crate::watch::run_watch(&rig, a),
         Command::Diagnose(a) => crate::diagnose::command::run_diagnose(&rig, a),
         Command::Compensate(a) => crate::compensate::run_compensate(&rig, a),
+        Command::Fleet(a) => crate::fleet::run_fleet(&rig, cli.rig.as_deref(), a),
     }
 }
 

@@ -13,7 +13,9 @@
 //! - [`ingest`]: the firmware's defmt telemetry (decoded text) to a bench log.
 //! - [`commission`], [`tune`]: commissioning on the simulated motor and loop tuning from a
 //!   step log; [`can_commands`]: parameter changes as `cansend` lines and `candump` logs.
-//! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain.
+//! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain; [`fleet`]:
+//!   many logs diagnosed at once, one table, each drive's trends; [`timestamp`]: the RFC
+//!   3339 times of logs and predictions.
 //! - [`watch`]: the drive's telemetry live in the terminal, and the bench log as it comes.
 
 pub mod bench_log;
@@ -22,6 +24,7 @@ pub mod cli;
 pub mod commission;
 pub mod compensate;
 pub mod diagnose;
+pub mod fleet;
 pub mod ingest;
 pub mod output;
 pub mod plots;
@@ -30,6 +33,7 @@ pub mod rig_file;
 pub mod run;
 pub mod simulate;
 pub mod study;
+pub mod timestamp;
 pub mod tune;
 pub mod values;
 pub mod watch;

@@ -292,6 +292,12 @@ fn tolerance_rig(s: &mut Stream) -> Rig {
     r
 }
 
+/// A bench of the nominal design built within its tolerances ([`tolerance_rig`]), drawn
+/// from a stream of its own seeded with `seed`: the fleet generator's drives.
+pub fn seeded_tolerance_rig(seed: u64) -> Rig {
+    tolerance_rig(&mut Stream(Xoshiro256PlusPlus::seed_from_u64(seed)))
+}
+
 /// The optional columns without which the hidden `effects` cannot be seen in `test`: on a
 /// moving piston, its position for every effect of the pressure's volume balance and of
 /// the piston's force balance (without it the pump's largest flow is unknown), and the low

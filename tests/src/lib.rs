@@ -7,6 +7,7 @@
 
 pub mod blind;
 pub mod campaign;
+pub mod fleet;
 pub mod fuzz;
 pub mod integrator_accuracy;
 

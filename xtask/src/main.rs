@@ -3,9 +3,10 @@
 //!
 //! 1. what it needs installed when missing ([`setup`]): the `thumbv7em-none-eabihf` target
 //!    (rustup), the `flip-link` linker (cargo install), `qemu-system-arm` and `tmux`
-//!    (apt-get), Python's `cantools` (a virtual environment);
+//!    (apt-get), Python's `cantools`, `dask` and `distributed` (a virtual environment);
 //! 2. `cargo fmt --check` and `cargo clippy --workspace --all-targets -D warnings`;
-//! 3. the host tests of the whole workspace;
+//! 3. the host tests of the whole workspace, and `eha fleet` against its Dask driver on a
+//!    local two-worker cluster and against its shards ([`fleet_check`]);
 //! 4. the CAN DBC file: in sync with `firmware::can_protocol` ([`dbc`]), and cantools
 //!    against the firmware's codec both ways ([`can_check`]);
 //! 5. the firmware for the STM32G474RE with warnings denied, and its flash and static-RAM
@@ -19,7 +20,8 @@
 //!    checked, its bench log equal to `eha ingest`'s.
 //!
 //! `cargo xtask fw-size` does step 5 alone, `cargo xtask pil` step 6, `cargo xtask can`
-//! step 4; `cargo xtask dbc [--node N] [--out FILE]` writes the DBC file.
+//! step 4, `cargo xtask fleet` the fleet check of step 3; `cargo xtask dbc [--node N]
+//! [--out FILE]` writes the DBC file.
 
 use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
@@ -28,6 +30,7 @@ use std::process::Command;
 
 mod can_check;
 mod dbc;
+mod fleet_check;
 mod pil;
 mod setup;
 mod watch_check;
@@ -50,9 +53,10 @@ fn main() {
             .and_then(|()| pil::pil()),
         Some("dbc") => dbc::dbc(&args[1..]),
         Some("can") => can(),
+        Some("fleet") => setup::python().and_then(|p| fleet_check::check(&p)),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test | fw-size | pil | can | dbc [--node N] [--out FILE]>"
+                "usage: cargo xtask <test | fw-size | pil | can | fleet | dbc [--node N] [--out FILE]>"
             );
             std::process::exit(2);
         }
@@ -139,6 +143,7 @@ fn test() -> Result<()> {
         ]),
     )?;
     run("host tests", cargo().args(["test", "--workspace"]))?;
+    fleet_check::check(&python)?;
     let text = dbc::generate(dbc::DEFAULT_NODE)?;
     dbc::check_in_sync(&text, &root().join(dbc::FILE))?;
     can_check::check(&python)?;

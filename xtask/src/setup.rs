@@ -5,9 +5,10 @@
 //!   `cargo install --locked` at the version [`FLIP_LINK_VERSION`];
 //! - `qemu-system-arm` (QEMU's Cortex-M4F, `mps2-an386`) for the processor-in-the-loop run;
 //! - `tmux`, the terminal `eha watch`'s screen test runs the live view in;
-//! - Python's `cantools` (pinned in `xtask/requirements.txt`) in a virtual environment under
-//!   the target directory, for the DBC check. `EHA_PYTHON` names an interpreter that has it
-//!   already (`.ci/run` makes one); a missing or broken one is an error, never a skip.
+//! - Python's `cantools`, `dask` and `distributed` (pinned in `xtask/requirements.txt`) in a
+//!   virtual environment under the target directory, for the DBC check and the fleet's Dask
+//!   driver. `EHA_PYTHON` names an interpreter that has them already (`.ci/run` makes one);
+//!   a missing or broken one is an error, never a skip.
 //!
 //! apt-get runs only when something is missing, after `apt-get update`.
 
@@ -88,23 +89,27 @@ pub fn tools() -> Result<()> {
     Ok(())
 }
 
-fn has_cantools(python: &std::path::Path) -> bool {
+/// What the checks import: cantools (the DBC check), dask.distributed (the fleet check).
+const IMPORTS: &str = "import cantools, dask.distributed";
+
+fn has_packages(python: &std::path::Path) -> bool {
     Command::new(python)
-        .args(["-c", "import cantools"])
+        .args(["-c", IMPORTS])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .status()
         .is_ok_and(|s| s.success())
 }
 
-/// A Python interpreter with `cantools`: `EHA_PYTHON`, or the target directory's virtual
-/// environment (made and filled from `xtask/requirements.txt` when missing).
+/// A Python interpreter with `cantools`, `dask` and `distributed`: `EHA_PYTHON`, or the
+/// target directory's virtual environment (made and filled from `xtask/requirements.txt`
+/// when missing).
 pub fn python() -> Result<PathBuf> {
     if let Some(p) = std::env::var_os("EHA_PYTHON") {
         let p = PathBuf::from(p);
-        if !has_cantools(&p) {
+        if !has_packages(&p) {
             bail!(
-                "EHA_PYTHON={} cannot import cantools (pip install -r xtask/requirements.txt)",
+                "EHA_PYTHON={} cannot `{IMPORTS}` (pip install -r xtask/requirements.txt)",
                 p.display()
             );
         }
@@ -112,7 +117,7 @@ pub fn python() -> Result<PathBuf> {
     }
     let venv = crate::target_dir().join("py-venv");
     let python = venv.join("bin").join("python");
-    if has_cantools(&python) {
+    if has_packages(&python) {
         return Ok(python);
     }
     let make = || {
@@ -130,17 +135,14 @@ pub fn python() -> Result<PathBuf> {
         }
     }
     crate::run(
-        "cantools into the check's virtual environment",
+        "cantools, dask and distributed into the checks' virtual environment",
         Command::new(&python)
             .args(["-m", "pip", "install", "--quiet", "-r"])
             .arg(crate::root().join("xtask").join("requirements.txt")),
     )
-    .context("installing cantools with pip")?;
-    if !has_cantools(&python) {
-        bail!(
-            "{} cannot import cantools after pip install",
-            python.display()
-        );
+    .context("installing the checks' Python packages with pip")?;
+    if !has_packages(&python) {
+        bail!("{} cannot `{IMPORTS}` after pip install", python.display());
     }
     Ok(python)
 }

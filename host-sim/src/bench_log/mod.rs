@@ -8,7 +8,9 @@
 //! value that is not a finite number, time that does not strictly increase, fewer than
 //! [`MIN_ROWS`] data rows, a row with the wrong number of fields — with a [`BenchLogError`]
 //! naming the file, the line and the column. Columns the contract does not know are skipped
-//! unread (a rig's logger may add a text column); unknown metadata keys are kept.
+//! unread (a rig's logger may add a text column); unknown metadata keys are kept. The keys
+//! `drive` and `recorded_at` name the actuator and the start time ([`BenchLog::drive`],
+//! [`BenchLog::recorded_at`]); [`read_metadata`] reads the metadata lines alone.
 //!
 //! Beyond the contract, for bounded memory and arithmetic: a line longer than
 //! [`limits::MAX_LINE_BYTES`], more rows than [`limits::max_rows`] allows (at most
@@ -36,6 +38,12 @@ use std::path::{Path, PathBuf};
 
 /// The fewest data rows a bench log may have.
 pub const MIN_ROWS: usize = 100;
+
+/// Metadata key naming the actuator a log comes from (`# drive: ID`).
+pub const DRIVE_KEY: &str = "drive";
+
+/// Metadata key of the time a log started (`# recorded_at: 2026-11-30T14:05:00Z`, RFC 3339).
+pub const RECORDED_AT_KEY: &str = "recorded_at";
 
 /// A column of the contract.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -212,6 +220,16 @@ impl BenchLog {
             .iter()
             .find(|(k, _)| k == key)
             .map(|(_, v)| v.as_str())
+    }
+
+    /// The actuator the log comes from (`# drive: ID`), if the log names it.
+    pub fn drive(&self) -> Option<&str> {
+        self.meta(DRIVE_KEY)
+    }
+
+    /// When the log started (`# recorded_at: …`, RFC 3339, as written), if the log says.
+    pub fn recorded_at(&self) -> Option<&str> {
+        self.meta(RECORDED_AT_KEY)
     }
 
     /// The column of `signal`, `None` for an absent optional column.
@@ -534,50 +552,9 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     };
     let mut input = BufReader::new(LineLimited::new(input));
     let mut log = BenchLog::default();
-
     // Metadata and blank lines before the header; the CSV reader takes over at the first
     // other line, so its line numbers are offset by the lines consumed here.
-    let mut consumed = 0usize;
-    let mut metadata_bytes = 0usize;
-    let mut line = String::new();
-    loop {
-        let buf = input.fill_buf().map_err(io_err)?;
-        let starts_meta = buf.first() == Some(&b'#')
-            || (consumed == 0 && buf.starts_with("\u{feff}#".as_bytes()));
-        let blank = buf.first() == Some(&b'\n') || buf.starts_with(b"\r\n");
-        if !(starts_meta || blank) {
-            break;
-        }
-        line.clear();
-        input.read_line(&mut line).map_err(|e| {
-            if let Some(l) = line_too_long(&e) {
-                err(l, "", Problem::LineTooLong)
-            } else if e.kind() == io::ErrorKind::InvalidData {
-                err(consumed + 1, "", Problem::NotUtf8)
-            } else {
-                io_err(e)
-            }
-        })?;
-        consumed += 1;
-        if starts_meta {
-            let text = line.trim_start_matches('\u{feff}').trim_start_matches('#');
-            let (k, v) = text.split_once(':').unwrap_or((text, ""));
-            let (k, v) = (k.trim(), v.trim());
-            if k.is_empty() && v.is_empty() {
-                continue; // a bare `#`: nothing to keep, like a blank line
-            }
-            // What the writer could not write back (an empty key, a carriage return inside
-            // the value) is refused here too, so every log read can be written.
-            if !metadata_fits(k, v) {
-                return Err(err(consumed, k, Problem::BadMetadata));
-            }
-            metadata_bytes += k.len() + v.len();
-            if log.metadata.len() == MAX_METADATA_LINES || metadata_bytes > MAX_METADATA_BYTES {
-                return Err(err(consumed, k, Problem::TooMuchMetadata));
-            }
-            log.metadata.push((k.to_string(), v.to_string()));
-        }
-    }
+    let consumed = parse_metadata(&mut input, path, &mut log.metadata)?;
 
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
@@ -699,6 +676,84 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
         ));
     }
     Ok(log)
+}
+
+/// Reads the `# key: value` lines (and blank lines) before the header of `input` into
+/// `metadata`, leaving `input` at the header; returns the lines consumed.
+fn parse_metadata<R: BufRead>(
+    input: &mut R,
+    path: &Path,
+    metadata: &mut Vec<(String, String)>,
+) -> Result<usize, BenchLogError> {
+    let err = |line: usize, column: &str, problem: Problem| BenchLogError::Content {
+        file: path.to_path_buf(),
+        line,
+        column: excerpt(column),
+        problem,
+    };
+    let io_err = |source| BenchLogError::Read {
+        file: path.to_path_buf(),
+        source,
+    };
+    let mut consumed = 0usize;
+    let mut metadata_bytes = 0usize;
+    let mut line = String::new();
+    loop {
+        let buf = input.fill_buf().map_err(io_err)?;
+        let starts_meta = buf.first() == Some(&b'#')
+            || (consumed == 0 && buf.starts_with("\u{feff}#".as_bytes()));
+        let blank = buf.first() == Some(&b'\n') || buf.starts_with(b"\r\n");
+        if !(starts_meta || blank) {
+            return Ok(consumed);
+        }
+        line.clear();
+        input.read_line(&mut line).map_err(|e| {
+            if let Some(l) = line_too_long(&e) {
+                err(l, "", Problem::LineTooLong)
+            } else if e.kind() == io::ErrorKind::InvalidData {
+                err(consumed + 1, "", Problem::NotUtf8)
+            } else {
+                io_err(e)
+            }
+        })?;
+        consumed += 1;
+        if starts_meta {
+            let text = line.trim_start_matches('\u{feff}').trim_start_matches('#');
+            let (k, v) = text.split_once(':').unwrap_or((text, ""));
+            let (k, v) = (k.trim(), v.trim());
+            if k.is_empty() && v.is_empty() {
+                continue; // a bare `#`: nothing to keep, like a blank line
+            }
+            // What the writer could not write back (an empty key, a carriage return inside
+            // the value) is refused here too, so every log read can be written.
+            if !metadata_fits(k, v) {
+                return Err(err(consumed, k, Problem::BadMetadata));
+            }
+            metadata_bytes += k.len() + v.len();
+            if metadata.len() == MAX_METADATA_LINES || metadata_bytes > MAX_METADATA_BYTES {
+                return Err(err(consumed, k, Problem::TooMuchMetadata));
+            }
+            metadata.push((k.to_string(), v.to_string()));
+        }
+    }
+}
+
+/// Reads only the metadata lines of the bench log at `path` (what `eha fleet` needs to
+/// sort a log before diagnosing it), with the reader's rules for them; the rows are not
+/// read or checked.
+pub fn read_metadata(path: &Path) -> Result<Vec<(String, String)>, BenchLogError> {
+    let io_err = |source| BenchLogError::Read {
+        file: path.to_path_buf(),
+        source,
+    };
+    if let Some(why) = crate::output::paths::input_problem(path) {
+        return Err(io_err(io::Error::new(io::ErrorKind::InvalidInput, why)));
+    }
+    let file = File::open(path).map_err(io_err)?;
+    let mut input = BufReader::new(LineLimited::new(file));
+    let mut metadata = Vec::new();
+    parse_metadata(&mut input, path, &mut metadata)?;
+    Ok(metadata)
 }
 
 /// Whether a metadata line `# k: v` can be written and read back as this key and value: a

@@ -266,3 +266,38 @@ fn metadata_the_writer_cannot_write_is_refused_on_reading() {
     assert_eq!(ok.meta("rig"), Some("x"));
     assert!(ok.check(Path::new("t.csv")).is_ok());
 }
+
+#[test]
+fn drive_and_recorded_at_are_kept_and_read_alone_from_the_head() {
+    let text = format!(
+        "# drive: press-07\n# recorded_at: 2026-11-30T14:05:00Z\n{}",
+        log_text(120, HEADER, good_row)
+    );
+    let log = parse_str(&text).unwrap();
+    assert_eq!(log.drive(), Some("press-07"));
+    assert_eq!(log.recorded_at(), Some("2026-11-30T14:05:00Z"));
+    // Written back, both lines come first and read back the same.
+    let bytes = to_bytes(&log).unwrap();
+    assert!(String::from_utf8_lossy(&bytes).starts_with("# drive: press-07\n"));
+    // The head alone: the metadata without reading the rows (which here are broken).
+    let dir = crate::output::scratch_dir("bench-log-meta");
+    let path = dir.join("head.csv");
+    let head = "# drive: press-07\n# recorded_at: 2026-11-30T14:05:00Z\nt_s,oops\nnot,a,row\n";
+    std::fs::write(&path, head).unwrap();
+    let meta = read_metadata(&path).unwrap();
+    assert_eq!(
+        meta,
+        vec![
+            ("drive".to_string(), "press-07".to_string()),
+            (
+                "recorded_at".to_string(),
+                "2026-11-30T14:05:00Z".to_string()
+            )
+        ]
+    );
+    assert!(read(&path).is_err());
+    // A missing file names itself.
+    let e = read_metadata(&dir.join("absent.csv")).unwrap_err();
+    assert!(e.to_string().contains("absent.csv"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -257,6 +257,21 @@ pub fn output_dir(
             "names no folder by its name; eha replaces its output folder whole: name one",
         ));
     }
+    let existing = folder_to_be(flag, path, inputs)?;
+    if existing != path {
+        return writable_folder(flag, path, existing);
+    }
+    if let Some(why) = super::folder::problem(path, owned, inputs) {
+        return Err(bad(flag, path, why));
+    }
+    // The folder is replaced by one staged beside it: beside the folder a link names.
+    let place = fs::canonicalize(path).map_err(|e| bad(flag, path, describe(&e)))?;
+    writable_folder(flag, path, parent_of(&place))
+}
+
+/// The nearest existing ancestor of the output folder `path` (or `path`), which must be a
+/// folder (create_dir_all makes the rest); `path` must be none of `inputs`.
+fn folder_to_be<'p>(flag: &str, path: &'p Path, inputs: &[&Path]) -> Result<&'p Path, CliError> {
     for input in inputs {
         if same_file(path, input) {
             return Err(bad(
@@ -288,15 +303,18 @@ pub fn output_dir(
             Err(e) => return Err(bad(flag, path, describe(&e))),
         }
     }
-    if existing != path {
-        return writable_folder(flag, path, existing);
+    Ok(existing)
+}
+
+/// Checks a folder a command keeps across runs and writes outputs into one by one (`eha
+/// fleet --out`, which holds its kept diagnoses), never replaced whole: not an input, and an
+/// existing folder, or one that can be created, in which eha can create files.
+pub fn kept_dir(flag: &str, path: &Path, inputs: &[&Path]) -> Result<(), CliError> {
+    if path.as_os_str().is_empty() {
+        return Err(CliError::BadInput(format!("{flag}: the path is empty")));
     }
-    if let Some(why) = super::folder::problem(path, owned, inputs) {
-        return Err(bad(flag, path, why));
-    }
-    // The folder is replaced by one staged beside it: beside the folder a link names.
-    let place = fs::canonicalize(path).map_err(|e| bad(flag, path, describe(&e)))?;
-    writable_folder(flag, path, parent_of(&place))
+    let existing = folder_to_be(flag, path, inputs)?;
+    writable_folder(flag, path, existing)
 }
 
 /// Checks that every output differs from every other (`-` may repeat only once: two JSON

@@ -10,6 +10,7 @@
 //! would leave plotters' tick search without end.
 
 pub mod png;
+pub mod trend;
 
 /// Widest axis span drawn (a plot of wider data is refused, not drawn). [axis unit]
 pub const MAX_SPAN: f64 = 1e100;

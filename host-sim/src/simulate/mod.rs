@@ -57,6 +57,14 @@ pub struct SimulateArgs {
     /// are 1 kHz). [Hz]
     #[arg(long, value_name = "HZ", default_value = "2000", value_parser = log_rate, allow_negative_numbers = true)]
     pub log_rate: f64,
+    /// The actuator the log is of, written as the log's `# drive:` line (what `eha fleet`
+    /// groups logs by).
+    #[arg(long, value_name = "ID", value_parser = drive_id)]
+    pub drive: Option<String>,
+    /// When the log started, RFC 3339 (`2026-11-30T14:05:00Z`), written as the log's
+    /// `# recorded_at:` line (what `eha fleet` trends over).
+    #[arg(long, value_name = "TIME", value_parser = crate::timestamp::rfc3339_arg)]
+    pub recorded_at: Option<String>,
     /// Name the scenarios and exit.
     #[arg(long)]
     pub list: bool,
@@ -94,6 +102,21 @@ fn log_rate(s: &str) -> Result<f64, String> {
         return Err(format!("{v} Hz is above the 20000 Hz telemetry rate"));
     }
     Ok(v)
+}
+
+/// A drive's name as a metadata value: not empty, on one line, no surrounding blanks.
+pub fn drive_id(s: &str) -> Result<String, String> {
+    let t = s.trim();
+    if t.is_empty() {
+        return Err("a drive needs a name".into());
+    }
+    if t.contains(['\n', '\r']) {
+        return Err(format!(
+            "`{}`: a drive's name must be on one line",
+            crate::bench_log::limits::excerpt(s)
+        ));
+    }
+    Ok(t.to_string())
 }
 
 impl SimulateArgs {
@@ -325,6 +348,12 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     ];
     if let Some(path) = &args.plant_rig {
         metadata.push(("plant_rig".into(), path.display().to_string()));
+    }
+    if let Some(drive) = &args.drive {
+        metadata.push((bench_log::DRIVE_KEY.into(), drive.clone()));
+    }
+    if let Some(at) = &args.recorded_at {
+        metadata.push((bench_log::RECORDED_AT_KEY.into(), at.clone()));
     }
     if let (Some(path), Some(t)) = (&args.compensation, &compensation) {
         metadata.push((
