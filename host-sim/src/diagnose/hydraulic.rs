@@ -136,15 +136,10 @@ pub struct HydraulicInputs<'a> {
     pub start_rows: usize,
     /// The fill level the port's check valve holds it above, as the transducer reads it. [Pa]
     pub fill_pa: f64,
-    /// Rows between the predicted ones: a fast log is integrated in steps of about
-    /// [`FIT_STEP_S`] when fitted (1 when every row is predicted).
+    /// Rows between the predicted ones (1: every row). Integrating a 10 kHz log in 1 ms
+    /// steps read a leak as a 0.15 s transducer lag, so the fits predict every row.
     pub stride: usize,
 }
-
-/// Time between the rows a fit predicts: a 10 kHz log is integrated in the steps a 1 kHz
-/// log is (each still cut into substeps of at most [`MAX_SUBSTEP_S`]), so the fits cost
-/// what they cost on a 1 kHz log of the same length. [s]
-pub const FIT_STEP_S: f64 = 1e-3;
 
 /// The rows of `rows` a window with `stride` predicts: every `stride`-th from the first,
 /// and the last.
@@ -174,14 +169,6 @@ impl<'a> HydraulicInputs<'a> {
                 f64::NEG_INFINITY
             },
             stride: 1,
-        }
-    }
-
-    /// The same inputs, predicted every [`FIT_STEP_S`] (as a fit reads them).
-    pub fn for_fit(self, period_s: f64) -> HydraulicInputs<'a> {
-        HydraulicInputs {
-            stride: rows_spanning(FIT_STEP_S, period_s, 1),
-            ..self
         }
     }
 }

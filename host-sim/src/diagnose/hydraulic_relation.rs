@@ -4,11 +4,9 @@
 //! windows in noise units.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{scaled, Relation, Release, CORRELATION_BIN_S};
-use crate::diagnose::facts::{rows_spanning, LogFacts};
-use crate::diagnose::hydraulic::{
-    strided, HydraulicInputs, HydraulicParams, Hydraulics, FIT_STEP_S,
-};
+use crate::diagnose::calibration::{scaled, Relation, Release};
+use crate::diagnose::facts::LogFacts;
+use crate::diagnose::hydraulic::{strided, HydraulicInputs, HydraulicParams, Hydraulics};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use plant_model::accumulator::GasCharge;
 use plant_model::Rig;
@@ -166,7 +164,7 @@ pub fn hydraulic_residuals(
 ) -> Vec<f64> {
     let sigma = facts.noise(Signal::Pressure).unwrap_or(1.0).max(1.0);
     let model = Hydraulics::new(params, rig);
-    let inputs = HydraulicInputs::of(log, facts).for_fit(facts.period_s);
+    let inputs = HydraulicInputs::of(log, facts);
     let mut out = Vec::new();
     let mut pred = Vec::new();
     for w in windows {
@@ -195,11 +193,6 @@ pub struct HydraulicRelation<'a> {
 impl Relation for HydraulicRelation<'_> {
     fn facts(&self) -> &LogFacts {
         self.facts
-    }
-    fn correlation_bin(&self) -> usize {
-        // The residuals stand [`FIT_STEP_S`] apart (a row each on a log up to 1 kHz).
-        let step = self.facts.period_s * rows_spanning(FIT_STEP_S, self.facts.period_s, 1) as f64;
-        rows_spanning(CORRELATION_BIN_S, step, 1)
     }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         hydraulic_specs(self.rig, release)
