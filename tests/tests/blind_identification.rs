@@ -52,7 +52,7 @@ use tests::blind::{
 /// their place in [`COVERAGE`] before any was diagnosed.
 const CI_SEEDS: [u64; 4] = [9, 14, 31, 35];
 
-/// Seeds of the CI part the diagnosis gets wrong today (issue 27): the suite reports them
+/// Seeds of the CI part the diagnosis gets wrong today: the suite reports them
 /// and fails when one of them is right (take it out) or any other seed fails.
 /// - 9, step, extra leakage + current offset: both named, the leak 39 % low;
 /// - 14, staircase, dead time 1.95 µs with voltages: named flux harmonics and sensor lag;

@@ -136,18 +136,6 @@ pub struct HydraulicInputs<'a> {
     pub start_rows: usize,
     /// The fill level the port's check valve holds it above, as the transducer reads it. [Pa]
     pub fill_pa: f64,
-    /// Rows between the predicted ones (1: every row). Integrating a 10 kHz log in 1 ms
-    /// steps read a leak as a 0.15 s transducer lag, so the fits predict every row.
-    pub stride: usize,
-}
-
-/// The rows of `rows` a window with `stride` predicts: every `stride`-th from the first,
-/// and the last.
-pub fn strided(rows: Range<usize>, stride: usize) -> impl Iterator<Item = usize> {
-    let last = rows.end.saturating_sub(1);
-    (rows.start..rows.end)
-        .step_by(stride.max(1))
-        .chain((last > rows.start && (last - rows.start) % stride.max(1) != 0).then_some(last))
 }
 
 impl<'a> HydraulicInputs<'a> {
@@ -168,7 +156,6 @@ impl<'a> HydraulicInputs<'a> {
             } else {
                 f64::NEG_INFINITY
             },
-            stride: 1,
         }
     }
 }
@@ -269,14 +256,14 @@ impl Hydraulics {
             [&mut a, &mut b],
         );
         let (mut num, mut den) = (0.0, 0.0);
-        for k in strided(rows.clone(), x.stride).skip(1) {
+        for k in rows.start + 1..rows.end {
             let i = k - rows.start;
             let g = (b[i] - a[i]) / delta;
             num += g * (x.p_pa[k] - a[i]);
             den += g * g;
         }
         let shift = if den > 0.0 { num / den } else { 0.0 };
-        for k in strided(rows.clone(), x.stride) {
+        for k in rows.clone() {
             let i = k - rows.start;
             out[i] = a[i] + shift * (b[i] - a[i]) / delta;
         }
@@ -309,9 +296,8 @@ impl Hydraulics {
         let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
         // The transducer's step factor 1 − e^(−h/τ), recomputed only when h changes.
         let mut lag = (f64::NAN, 1.0);
-        let steps_at: Vec<usize> = strided(rows.clone(), x.stride).collect();
-        for pair in steps_at.windows(2) {
-            let (k, next) = (pair[0], pair[1]);
+        for k in rows.start..rows.end.saturating_sub(1) {
+            let next = k + 1;
             let dt = x.t_s[next] - x.t_s[k];
             let steps = ((dt / MAX_SUBSTEP_S).ceil() as usize).max(1);
             let h = dt / steps as f64;
@@ -432,7 +418,6 @@ mod tests {
             p_pa: &p,
             start_rows: 10,
             fill_pa: 0.0,
-            stride: 1,
         };
         let mut out = vec![0.0; n];
         Hydraulics::new(hp.clone(), &Rig::nominal()).simulate_window(

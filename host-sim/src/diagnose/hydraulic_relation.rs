@@ -6,7 +6,7 @@
 use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::calibration::{scaled, Relation, Release};
 use crate::diagnose::facts::LogFacts;
-use crate::diagnose::hydraulic::{strided, HydraulicInputs, HydraulicParams, Hydraulics};
+use crate::diagnose::hydraulic::{HydraulicInputs, HydraulicParams, Hydraulics};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use plant_model::accumulator::GasCharge;
 use plant_model::Rig;
@@ -171,11 +171,7 @@ pub fn hydraulic_residuals(
         pred.clear();
         pred.resize(w.len(), 0.0);
         model.predict_window(&inputs, w.clone(), &mut pred);
-        out.extend(
-            strided(w.clone(), inputs.stride)
-                .skip(1)
-                .map(|k| huber((log.p_pa[k] - pred[k - w.start]) / sigma)),
-        );
+        out.extend((w.start + 1..w.end).map(|k| huber((log.p_pa[k] - pred[k - w.start]) / sigma)));
     }
     out
 }
