@@ -22,6 +22,7 @@ use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use plant_model::rig::InverterParams;
 use plant_model::Rig;
 use std::ops::Range;
+use std::sync::OnceLock;
 
 /// Time on each side of the currents' central differences (one row of a 1 kHz log): a
 /// faster log's current noise is not differentiated over a shorter interval. [s]
@@ -65,6 +66,9 @@ pub struct ElectricalRelation<'a> {
     pub rig: &'a Rig,
     /// Mean DC link (logged, else the rig's). [V]
     pub u_dc_v: f64,
+    /// (sin, cos) of the electrical angle p_n·θ at every row, made at the first prediction
+    /// that needs it (the dead-time loss) and shared by every later one.
+    angle: OnceLock<Vec<(f64, f64)>>,
 }
 
 impl<'a> ElectricalRelation<'a> {
@@ -85,6 +89,7 @@ impl<'a> ElectricalRelation<'a> {
             facts,
             rig,
             u_dc_v,
+            angle: OnceLock::new(),
         })
     }
 
@@ -108,6 +113,14 @@ impl<'a> ElectricalRelation<'a> {
                 0.0
             }
         };
+        let angle: &[(f64, f64)] = if inverter.has_dead_time() {
+            self.angle.get_or_init(|| {
+                let theta = &self.facts.theta_rad;
+                theta.iter().map(|th| (pp * th).sin_cos()).collect()
+            })
+        } else {
+            &[]
+        };
         let base = rows.start;
         for k in rows {
             let (i_d, i_q) = (log.id_a[k], log.iq_a[k]);
@@ -117,7 +130,7 @@ impl<'a> ElectricalRelation<'a> {
                 + v[ix::LQ] * deriv(&log.iq_a, k)
                 + w_e * (v[ix::LD] * i_d + v[ix::PSI]);
             if inverter.has_dead_time() {
-                let (s, c) = (pp * self.facts.theta_rad[k]).sin_cos();
+                let (s, c) = angle[k];
                 let i_abc = dq_to_abc(i_d, i_q, s, c);
                 let (loss_d, loss_q) = pole_to_dq(&inverter.pole_voltages(&[0.0; 3], &i_abc), s, c);
                 u_d -= loss_d;

@@ -315,19 +315,33 @@ impl Hydraulics {
                 None => (0.0, 0.0),
             };
             let p_low = x.p_low_pa[k];
-            for j in 0..steps {
-                let f = (j as f64 + 0.5) / steps as f64;
-                let factor = if ripple {
-                    self.pump.displacement_factor(x.theta_rad[k] + f * dtheta)
-                } else {
-                    1.0
-                };
-                // Flow into the node over the substep: pump minus piston, as a mean. [m³/s]
-                let q_in = (per_rad * factor * dtheta - hp.area_m2 * dx) / dt;
+            // Flow into the node over a substep: pump minus piston, as a mean [m³/s]; and
+            // the oil's capacitance at the piston's position [m³/Pa]. Both are the row's
+            // own unless the pump ripples or the piston moves.
+            let q_at = |factor: f64| (per_rad * factor * dtheta - hp.area_m2 * dx) / dt;
+            let c_at = |f: f64| {
                 let volume = hp.high_side_volume_m3 + hp.area_m2 * (x0 + f * dx);
-                let c_oil = volume.max(1e-9) / hp.bulk_modulus_pa;
-                for st in st.iter_mut() {
-                    self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
+                volume.max(1e-9) / hp.bulk_modulus_pa
+            };
+            if !ripple && dx == 0.0 {
+                let (q_in, c_oil) = (q_at(1.0), c_at(0.0));
+                for _ in 0..steps {
+                    for st in st.iter_mut() {
+                        self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
+                    }
+                }
+            } else {
+                for j in 0..steps {
+                    let f = (j as f64 + 0.5) / steps as f64;
+                    let factor = if ripple {
+                        self.pump.displacement_factor(x.theta_rad[k] + f * dtheta)
+                    } else {
+                        1.0
+                    };
+                    let (q_in, c_oil) = (q_at(factor), c_at(f));
+                    for st in st.iter_mut() {
+                        self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
+                    }
                 }
             }
             for (o, st) in out.iter_mut().zip(&st) {

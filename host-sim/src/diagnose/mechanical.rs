@@ -23,13 +23,14 @@
 
 use crate::bench_log::BenchLog;
 use crate::diagnose::facts::{rows_spanning, LogFacts};
-use plant_model::motor::Motor;
+use plant_model::motor::{Motor, Phasor};
 use plant_model::pump::Pump;
 use plant_model::rig::{MotorParams, PumpParams};
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
 use std::ops::Range;
+use std::sync::OnceLock;
 
 /// Time on each side of the central differences that give speed and acceleration (five
 /// rows of a 1 kHz log): a span in time, so a faster log's encoder quantisation is not
@@ -111,6 +112,12 @@ pub struct ShaftMotion {
     /// The q current's moving mean ([`MEAN_CURRENT_HALF_WIDTH_S`]), which scales the flux
     /// harmonics' torque line. [A]
     pub iq_mean_a: Vec<f64>,
+    /// The Coulomb friction's sign, faded through zero speed: tanh(ω/[`COULOMB_FADE_RAD_S`])
+    /// at the shaft's speed, computed once for every fit that scales it. [1]
+    pub coulomb_shape: Vec<f64>,
+    /// The unit phasors of the shaft angle θ and of the electrical angle p_n·θ at every row,
+    /// made at the first evaluation that needs them, with the p_n they were made for.
+    phasors: OnceLock<(f64, Vec<[Phasor; 2]>)>,
     /// How the acceleration was read: what it keeps of a line ([`ShaftMotion::accel_gain`]).
     pub accel_filter: AccelFilter,
 }
@@ -197,12 +204,34 @@ impl ShaftMotion {
             let accel = central_rate(&log.t_s, &log.speed_rad_s, h);
             (log.speed_rad_s.clone(), accel, central)
         };
+        let coulomb_shape = speed
+            .iter()
+            .map(|w| (w / COULOMB_FADE_RAD_S).tanh())
+            .collect();
         ShaftMotion {
+            coulomb_shape,
+            phasors: OnceLock::new(),
             speed_rad_s: speed,
             accel_rad_s2: accel,
             iq_mean_a: mean_current(&log.iq_a, facts.period_s),
             accel_filter,
         }
+    }
+
+    /// The phasors of θ and of `pole_pairs`·θ at every row of `facts` (the log this motion
+    /// is of), computed once: the cogging torque, the flux harmonics and the pump's ripple
+    /// are evaluated at them in every fit.
+    fn phasors(&self, facts: &LogFacts, pole_pairs: f64) -> &[[Phasor; 2]] {
+        let (pp, v) = self.phasors.get_or_init(|| {
+            let v = facts
+                .theta_rad
+                .iter()
+                .map(|th| [Phasor::of(*th), Phasor::of(pole_pairs * th)])
+                .collect();
+            (pole_pairs, v)
+        });
+        debug_assert_eq!(*pp, pole_pairs, "one motor per log's motion");
+        v
     }
 
     /// The fraction of a shaft oscillation's acceleration at angular frequency `w` that
@@ -262,31 +291,37 @@ impl Mechanics {
     /// Electromagnetic torque at row `k` as (∂T/∂i_q, the rest) with the logged i_d, so the
     /// torque is slope·i_q + rest (eq. 3 with the flux harmonics, plus cogging). [N·m/A, N·m]
     #[inline]
-    fn torque_terms(&self, log: &BenchLog, facts: &LogFacts, k: usize) -> (f64, f64) {
-        let theta = facts.theta_rad[k];
-        let flux = self
-            .motor
-            .magnet_flux(self.params.motor.pole_pairs as f64 * theta);
+    fn torque_terms(&self, log: &BenchLog, rot: [Phasor; 2], k: usize) -> (f64, f64) {
+        let [mechanical, electrical] = rot;
+        let flux = self.motor.magnet_flux_at(electrical);
         let id = log.id_a[k];
         let rest = self.motor.torque_nm(id, 0.0, &flux);
         let slope = self.motor.torque_nm(id, 1.0, &flux) - rest;
-        (slope, rest + self.motor.cogging_torque_nm(theta))
+        (slope, rest + self.motor.cogging_torque_at(mechanical))
     }
 
-    /// Load torque at row `k` from the logged pressures and angle, the shaft at `speed`:
-    /// pump, viscous and Coulomb friction. [N·m]
+    /// Load torque at row `k` from the logged pressures and angle, the shaft at `speed` with
+    /// the Coulomb friction's faded sign `shape`: pump, viscous and Coulomb friction. [N·m]
     #[inline]
-    fn load_torque(&self, log: &BenchLog, facts: &LogFacts, k: usize, speed: f64) -> f64 {
+    fn load_torque(
+        &self,
+        log: &BenchLog,
+        facts: &LogFacts,
+        k: usize,
+        rot: Phasor,
+        speed: f64,
+        shape: f64,
+    ) -> f64 {
         let m = &self.params;
         let factor = if m.pump.piston_ripple {
-            self.pump.displacement_factor(facts.theta_rad[k])
+            self.pump.displacement_factor_at(facts.theta_rad[k], rot)
         } else {
             1.0
         };
         self.pump
             .load_torque(log.p_pa[k], facts.p_low_pa[k], factor)
             + m.viscous_nm_s * speed
-            + m.coulomb_nm * (speed / COULOMB_FADE_RAD_S).tanh()
+            + m.coulomb_nm * shape
     }
 
     /// The unexplained torque lines at row `k` (electromagnetic torque `t_em`), each the
@@ -328,11 +363,15 @@ impl Mechanics {
     ) {
         let j = self.params.inertia_kg_m2;
         let slow = &motion.iq_mean_a;
+        let rotation = motion.phasors(facts, self.params.motor.pole_pairs as f64);
         let base = rows.start;
         for k in rows {
             let w = motion.speed_rad_s[k];
-            let need = self.load_torque(log, facts, k, w) + j * motion.accel_rad_s2[k];
-            let (slope, rest) = self.torque_terms(log, facts, k);
+            let rot = rotation[k];
+            let shape = motion.coulomb_shape[k];
+            let need =
+                self.load_torque(log, facts, k, rot[0], w, shape) + j * motion.accel_rad_s2[k];
+            let (slope, rest) = self.torque_terms(log, rot, k);
             let slope = if slope.abs() > 1e-9 { slope } else { 1e-9 };
             let t_mean = slope * slow[k] + rest;
             out[k - base] = (need - rest + self.line_torque(log, facts, motion, k, t_mean)) / slope;
@@ -352,15 +391,17 @@ impl Mechanics {
         let t = &log.t_s;
         let j = self.params.inertia_kg_m2.max(1e-12);
         let slow = &motion.iq_mean_a;
+        let rotation = motion.phasors(facts, self.params.motor.pole_pairs as f64);
         for win in windows {
             let mut w = motion.speed_rad_s[win.start];
             out[win.start] = w;
             for k in win.start..win.end - 1 {
-                let (slope, rest) = self.torque_terms(log, facts, k);
+                let rot = rotation[k];
+                let (slope, rest) = self.torque_terms(log, rot, k);
                 let t_em = slope * log.iq_a[k] + rest;
                 let drive = t_em
                     - self.line_torque(log, facts, motion, k, slope * slow[k] + rest)
-                    - self.load_torque(log, facts, k, w);
+                    - self.load_torque(log, facts, k, rot[0], w, (w / COULOMB_FADE_RAD_S).tanh());
                 w += (t[k + 1] - t[k]) * drive / j;
                 out[k + 1] = w;
             }
