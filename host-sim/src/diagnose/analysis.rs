@@ -14,58 +14,25 @@
 //!    order spectra of the baseline) and the contract's result.
 
 use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
-use super::calibration::{
-    calibrate, mech, test_release_at_nominal, thinned, Calibration, HydraulicRelation,
-    MechanicalRelation, Patient, Release, HYDRAULIC_WINDOW_S, MAX_FIT_S,
-};
+use super::calibration::{calibrate, test_release_at_nominal, Release};
 use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
-use super::contributions::{contributions, Contributions};
-use super::cylinder::{self, CylinderRelation};
+use super::contributions::contributions;
+use super::cylinder::{self};
 use super::diagnosis::Diagnosis;
-use super::electrical::ElectricalRelation;
-use super::facts::{rows_spanning, LogFacts};
-use super::least_squares::{PATIENCE, THOROUGH_PATIENCE};
+use super::error::DiagnoseError;
+use super::facts::LogFacts;
+use super::findings::Analysis;
 use super::lines::window_lines;
 use super::mechanical::ShaftMotion;
+use super::mechanical_relation::mech;
 use super::predictions::{predict, Context, ModelValues};
+pub use super::relations::Precision;
+use super::relations::{Calibrations, Relations};
 use super::result::{assemble, extended_values};
 use super::selection::select;
-use super::signatures::ResidualSignature;
-use super::spectrum::OrderSpectrum;
-use super::DiagnoseError;
 use crate::bench_log::BenchLog;
-use plant_model::pump::ripple_order;
 use plant_model::Rig;
-use std::collections::BTreeMap;
-use std::ops::Range;
 use std::path::Path;
-
-/// Length of the mechanical relation's calibration windows (thinned on long logs). [s]
-const MECHANICAL_WINDOW_S: f64 = 1.0;
-
-/// Everything the diagnosis computed, for the JSON and the report.
-pub struct Analysis {
-    /// The contract's result.
-    pub diagnosis: Diagnosis,
-    /// The log's time. [s]
-    pub t_s: Vec<f64>,
-    /// Measured signals by name (those the models predict).
-    pub measured: BTreeMap<&'static str, Vec<f64>>,
-    /// Baseline (calibrated nominal) predictions by signal, whole log.
-    pub baseline: BTreeMap<&'static str, Vec<f64>>,
-    /// Extended predictions by signal, whole log (the baseline's when nothing was named).
-    pub extended: BTreeMap<&'static str, Vec<f64>>,
-    /// Order spectra of the baseline residuals (pressure, speed, q current).
-    pub spectra: Vec<(&'static str, OrderSpectrum)>,
-    /// Time-domain signatures of the baseline residuals.
-    pub signatures: Vec<ResidualSignature>,
-    /// Orders the candidates point at, for the plots: (order, effect).
-    pub candidate_orders: Vec<(u32, &'static str)>,
-    /// Every tested effect, most likely first.
-    pub tested: Vec<Tested>,
-    /// Fit points each named effect gains per signal as it joins the model in rank order.
-    pub contributions: Contributions,
-}
 
 /// Diagnoses `log` against the rig file `rig`.
 pub fn diagnose(log: &BenchLog, rig: &Rig) -> Result<Diagnosis, DiagnoseError> {
@@ -79,21 +46,6 @@ pub fn diagnose_to(
     precision: Precision,
 ) -> Result<Diagnosis, DiagnoseError> {
     analyse_reporting(log, rig, precision, &|_: &'static str| {}).map(|a| a.diagnosis)
-}
-
-/// The orders the lines are read at: a current offset's p_n, flux harmonics' and dead
-/// time's 6·p_n, the pumps' 2z and the rig's slot order.
-fn line_orders(rig: &Rig) -> Vec<u32> {
-    let pp = rig.motor.pole_pairs;
-    let mut v = vec![pp, 6 * pp, rig.motor.cogging_fundamental_order()];
-    v.extend(
-        super::candidates::RIPPLE_PISTONS
-            .iter()
-            .map(|z| ripple_order(*z)),
-    );
-    v.sort_unstable();
-    v.dedup();
-    v
 }
 
 /// What the pipeline reports as it goes: one call per finished step, naming the step
@@ -119,83 +71,9 @@ fn reported<T>(progress: &dyn Progress, value: T, next: &'static str) -> T {
 /// relations' tests, the lines' tests, the predictions and the evidence.
 pub const STEPS: u64 = 13;
 
-/// How far the fits are driven.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Precision {
-    /// Until the decision is settled: `eha diagnose`.
-    Diagnosis,
-    /// Until the fitted parameters stop moving: a feed-forward learned from them.
-    Learning,
-}
-
 /// Runs the whole diagnosis.
 pub fn analyse(log: &BenchLog, rig: &Rig) -> Result<Analysis, DiagnoseError> {
     analyse_reporting(log, rig, Precision::Diagnosis, &|_: &'static str| {})
-}
-
-/// The log's windows and the parity relations it supports.
-pub(super) struct Relations<'a> {
-    pub(super) h_id: Vec<Range<usize>>,
-    pub(super) h_val: Vec<Range<usize>>,
-    pub(super) m_id: Vec<Range<usize>>,
-    pub(super) m_val: Vec<Range<usize>>,
-    pub(super) hydraulic: HydraulicRelation<'a>,
-    pub(super) mechanical: MechanicalRelation<'a>,
-    pub(super) electrical: Option<ElectricalRelation<'a>>,
-    pub(super) cylinder: Option<CylinderRelation<'a>>,
-    pub(super) orders: Vec<u32>,
-    /// The optimiser's patience on every relation.
-    pub(super) patience: usize,
-}
-
-impl<'a> Relations<'a> {
-    fn of(
-        log: &'a BenchLog,
-        facts: &'a LogFacts,
-        motion: &'a ShaftMotion,
-        rig: &'a Rig,
-        precision: Precision,
-    ) -> Relations<'a> {
-        let budget = rows_spanning(MAX_FIT_S, facts.period_s, 1);
-        let windows =
-            |rows, length, signal: &[f64]| thinned(facts.windows(rows, length), signal, budget);
-        let orders = line_orders(rig);
-        Relations {
-            h_id: windows(facts.identification(), HYDRAULIC_WINDOW_S, &log.p_pa),
-            h_val: windows(facts.validation(), HYDRAULIC_WINDOW_S, &log.p_pa),
-            m_id: windows(
-                facts.identification(),
-                MECHANICAL_WINDOW_S,
-                &log.speed_rad_s,
-            ),
-            m_val: windows(facts.validation(), MECHANICAL_WINDOW_S, &log.speed_rad_s),
-            hydraulic: HydraulicRelation { log, facts, rig },
-            mechanical: MechanicalRelation::new(log, facts, motion, rig, &orders),
-            electrical: ElectricalRelation::of(log, facts, rig),
-            cylinder: CylinderRelation::of(log, facts, rig),
-            orders,
-            patience: match precision {
-                Precision::Diagnosis => PATIENCE,
-                Precision::Learning => THOROUGH_PATIENCE,
-            },
-        }
-    }
-
-    /// `relation` fitted with the precision's patience.
-    pub(super) fn patient<'r, R>(&self, relation: &'r R) -> Patient<'r, R> {
-        Patient {
-            relation,
-            patience: self.patience,
-        }
-    }
-}
-
-/// Each relation's baseline, fitted within the tolerance bands.
-pub(super) struct Calibrations {
-    pub(super) hydraulic: Calibration,
-    pub(super) mechanical: Calibration,
-    pub(super) electrical: Option<Calibration>,
-    pub(super) cylinder: Option<Calibration>,
 }
 
 /// Stage 2: every relation calibrated, in parallel.

@@ -46,14 +46,12 @@
 //! amplitude). Each carries the calibrated stator constants' tolerances
 //! ([`STATOR_TOLERANCE`]) on the terms computed with them.
 
-use crate::diagnose::dead_time::disturbance_sensitivity;
 use crate::diagnose::lines::{OrderLines, WindowLines};
+use crate::diagnose::loop_response::{
+    current_tracking, disturbance_sensitivity, speed_reference_per_angle, LOOP_TOLERANCE,
+};
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
-
-/// Relative uncertainty of the current and speed loops' responses computed from the rig's
-/// Table 1 gains and inductances. [1]
-pub const LOOP_TOLERANCE: f64 = 0.25;
 
 /// One measured line an amplitude explains: the line, what one unit of the amplitude makes
 /// of it, and its noise variance per real component.
@@ -163,24 +161,6 @@ pub fn voltage_lines(
             var: floor_d + vd,
         },
     ])
-}
-
-/// The q current's closed-loop response to its reference on `rig` at angular frequency
-/// `w`. [1]
-pub fn current_tracking(rig: &Rig, w: f64) -> Complex64 {
-    let c = closed_loop::controller_config(rig).current;
-    let m = &rig.motor;
-    let s = Complex64::new(0.0, w);
-    let (kp, ki) = (c.kp_q as f64, c.ki_q as f64);
-    (s * kp + ki) / (s * s * m.l_q_h + s * (m.r_s_ohm + kp) + ki)
-}
-
-/// The speed loop's q-current reference per unit angle line at `w`: C_ω(jw)·jw. [A/rad]
-pub fn speed_reference_per_angle(rig: &Rig, w: f64) -> Complex64 {
-    let c = closed_loop::controller_config(rig).speed;
-    let s = Complex64::new(0.0, w);
-    let pi = Complex64::new(c.kp as f64 + c.active_damping as f64, 0.0) + (c.ki as f64) / s;
-    pi * s
 }
 
 /// The q and d back-EMF lines of window `w` at its 6·p_n order `o` (`candidates` kept out

@@ -12,7 +12,7 @@
 //! | absorber shell V_0, precharge p_0 | ±5 % | listed ±2 % |
 //! | absorber inlet resistance R | ÷10 … ×30 | not listed (inlet, hose and bladder) |
 //! | leakage G (pump and cylinder) | ±20 % | coefficients listed; the path (eq. 9 or 10) not |
-//! | transducer gain, offset (zero), lag | ±1 %, ±30 kPa ([`SENSOR_OFFSET_BAND_PA`]), 0–2.5 ms | a calibrated transducer behind a snubber and an anti-aliasing filter; the zero in the cylinder relation too |
+//! | transducer gain, offset (zero), lag | ±1 %, ±30 kPa ([`SENSOR_OFFSET_BAND_PA`](super::hydraulic_relation::SENSOR_OFFSET_BAND_PA)), 0–2.5 ms | a calibrated transducer behind a snubber and an anti-aliasing filter; the zero in the cylinder relation too |
 //! | cylinder Coulomb and breakaway force | 0 … 3× the rig file's | seals wear in and out ([`super::cylinder`]) |
 //! | magnet flux ψ_f (K_t) | ±5 % | listed ±2 %; magnet temperature |
 //! | inertia J | ±10 % | assumed in the rig contract |
@@ -34,15 +34,6 @@ use crate::diagnose::least_squares::{
     fit_with_patience, variance_per_independent_sample, Fitted, ParamSpec, PATIENCE,
 };
 use std::ops::Range;
-
-pub use crate::diagnose::hydraulic_relation::{
-    hyd, hydraulic_params, hydraulic_residuals, hydraulic_specs, HydraulicRelation,
-    HYDRAULIC_WINDOW_S, LAG_BAND_S, SENSOR_OFFSET_BAND_PA,
-};
-pub use crate::diagnose::mechanical_relation::{
-    mech, mechanical_params, mechanical_specs, MechanicalRelation, MECHANICAL_SMOOTHING_ROWS,
-    SHAFT_COULOMB_BAND_NM, SPEED_WINDOW_S,
-};
 
 /// Most log time a fit evaluates per model run: longer segments are thinned
 /// ([`thinned`]). Twelve seconds fix every rig parameter the relations carry; more only

@@ -25,7 +25,7 @@ use crate::diagnose::angle_locked::{
     ShaftConstants, OFFSET_HYPOTHESES,
 };
 use crate::diagnose::calibration::{
-    hyd, mech, test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
+    test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
 };
 use crate::diagnose::cylinder;
 use crate::diagnose::dead_time::{
@@ -33,8 +33,10 @@ use crate::diagnose::dead_time::{
 };
 use crate::diagnose::electrical::DEAD_TIME_BAND_S;
 use crate::diagnose::hydraulic::nominal_leakage;
+use crate::diagnose::hydraulic_relation::hyd;
 use crate::diagnose::least_squares::ParamSpec;
 use crate::diagnose::lines::WindowLines;
+use crate::diagnose::mechanical_relation::mech;
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::Rig;
 use std::ops::Range;

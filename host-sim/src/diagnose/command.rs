@@ -2,7 +2,7 @@
 //! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
 use super::analysis::{analyse_reporting, Precision, STEPS};
-use super::DiagnoseError;
+use super::error::DiagnoseError;
 use crate::output::paths::Declared;
 use crate::output::{CliError, Outputs};
 use clap::Args;

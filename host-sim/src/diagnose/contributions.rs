@@ -7,6 +7,7 @@
 use super::angle_locked::ShaftConstants;
 use super::candidates::Tested;
 use super::facts::LogFacts;
+use super::findings::Contributions;
 use super::predictions::{predict, Context, ModelValues};
 use super::result::{extended_values, fit_of};
 use crate::bench_log::BenchLog;
@@ -15,9 +16,6 @@ use std::collections::BTreeMap;
 
 /// Predictions by signal, whole log.
 type Predicted = BTreeMap<&'static str, Vec<f64>>;
-
-/// Fit points gained per signal, per named effect in `named`'s order.
-pub type Contributions = Vec<(String, BTreeMap<String, f64>)>;
 
 /// The contributions of `named` (indices into `tested`) from the calibrated `base`
 /// values and predictions `baseline` to the `extended` predictions.

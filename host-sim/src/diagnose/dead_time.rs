@@ -25,8 +25,10 @@
 //! the fade band searched over a grid (it is not in the rig contract). Without the angle
 //! the phases are not placed: the magnitudes at the window's mean current.
 
-use crate::diagnose::back_emf::{current_tracking, speed_reference_per_angle, LOOP_TOLERANCE};
 use crate::diagnose::lines::{OrderLines, WindowLines};
+use crate::diagnose::loop_response::{
+    current_tracking, disturbance_sensitivity, speed_reference_per_angle, LOOP_TOLERANCE,
+};
 use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
@@ -60,19 +62,6 @@ pub fn sixth_harmonic_voltage(rig: &Rig, i_d: f64, i_q: f64, band: f64) -> (Comp
         q += e * uq;
     }
     (d, q)
-}
-
-/// The current loops' disturbance sensitivity on (d, q) at angular frequency `w` (signed:
-/// a line turning backwards is the conjugate). [A/V]
-pub fn disturbance_sensitivity(rig: &Rig, w: f64) -> (Complex64, Complex64) {
-    let c = closed_loop::controller_config(rig).current;
-    let m = &rig.motor;
-    let s = Complex64::new(0.0, w);
-    let h = |l: f64, kp: f64, ki: f64| s / (s * s * l + s * (m.r_s_ohm + kp) + ki);
-    (
-        h(m.l_d_h, c.kp_d as f64, c.ki_d as f64),
-        h(m.l_q_h, c.kp_q as f64, c.ki_q as f64),
-    )
 }
 
 /// A dead-time fit.

@@ -12,15 +12,14 @@
 //! the signal's own noise RMS from the log (1.0: explained down to the noise).
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{
-    hydraulic_params, mechanical_params, HYDRAULIC_WINDOW_S, SPEED_WINDOW_S,
-};
 use crate::diagnose::cylinder::CylinderRelation;
 use crate::diagnose::electrical::ElectricalRelation;
 use crate::diagnose::facts::LogFacts;
-use crate::diagnose::fit_percent;
+use crate::diagnose::fit_score::fit_percent;
 use crate::diagnose::hydraulic::{HydraulicInputs, Hydraulics};
+use crate::diagnose::hydraulic_relation::{hydraulic_params, HYDRAULIC_WINDOW_S};
 use crate::diagnose::mechanical::{Mechanics, ShaftMotion, TorqueLine};
+use crate::diagnose::mechanical_relation::{mechanical_params, SPEED_WINDOW_S};
 use plant_model::Rig;
 use std::collections::BTreeMap;
 use std::ops::Range;

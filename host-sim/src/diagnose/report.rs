@@ -6,8 +6,8 @@
 //! files are written into a staging folder that replaces DIR whole at the end, so a
 //! failure leaves DIR as it was and no file of an earlier log stays beside the new ones.
 
-use super::analysis::Analysis;
 use super::diagnosis::Diagnosis;
+use super::findings::Analysis;
 use super::spectrum::OrderSpectrum;
 use crate::output::{CliError, StagedFolder};
 use crate::plots::{line_chart, png, stacked_chart, Figure, Marker, Panel, Series};

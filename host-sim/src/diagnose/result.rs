@@ -2,15 +2,16 @@
 //! the validation segment, the evidence for the report (residual signatures, order
 //! spectra) and the contract's result, the causes ranked with why each was or was not named.
 
-use super::analysis::{Analysis, Calibrations, Relations};
 use super::angle_locked::ShaftConstants;
 use super::calibration::{Calibration, Relation, Release};
 use super::candidates::{Extension, Tested};
 use super::decision::{threshold, why_not};
 use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 use super::facts::LogFacts;
+use super::findings::Analysis;
 use super::mechanical::{LineScale, TorqueLine};
 use super::predictions::{scores, ModelValues};
+use super::relations::{Calibrations, Relations};
 use super::signatures::{residual_signature, Regressors, ResidualSignature};
 use super::spectrum::order_spectrum;
 use crate::bench_log::BenchLog;
@@ -48,7 +49,7 @@ pub(super) fn assemble(
         .iter()
         .filter_map(|name| {
             let y = measured.get(name)?;
-            let r = super::residual(y, baseline.get(name)?);
+            let r = super::fit_score::residual(y, baseline.get(name)?);
             Some((*name, order_spectrum(&facts.theta_rad, &r)?))
         })
         .collect();

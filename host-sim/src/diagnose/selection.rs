@@ -22,10 +22,10 @@
 //! log cannot tell them from is marked beside them ([`super::ambiguity`]).
 
 use super::ambiguity::mark;
-use super::analysis::Relations;
 use super::calibration::{calibrate, test_release, Calibration, Freed, Relation, Release};
 use super::candidates::{from_release, Extension, Tested};
 use super::decision::{apply_vetoes, threshold, why_not};
+use super::relations::Relations;
 use plant_model::Rig;
 
 /// Which residual an effect's test reads.

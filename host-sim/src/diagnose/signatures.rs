@@ -90,7 +90,7 @@ pub fn residual_signature(
     if n < 2 * WHITENESS_LAGS || lengths.iter().any(|l| *l != n) || dt_s.is_nan() || dt_s <= 0.0 {
         return None;
     }
-    let r = super::residual(measured, simulated);
+    let r = super::fit_score::residual(measured, simulated);
     let rms = (r.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
     let q = ljung_box(&r, WHITENESS_LAGS);
     let white_p = ChiSquared::new(WHITENESS_LAGS as f64)

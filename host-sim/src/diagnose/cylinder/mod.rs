@@ -61,8 +61,9 @@
 //! hold.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::calibration::{Relation, Release, SENSOR_OFFSET_BAND_PA};
+use crate::diagnose::calibration::{Relation, Release};
 use crate::diagnose::facts::{rows_spanning, LogFacts, MOVING_PISTON_TRAVEL_M};
+use crate::diagnose::hydraulic_relation::SENSOR_OFFSET_BAND_PA;
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use crate::diagnose::mechanical::central_rate;
 use crate::diagnose::stick::Stick;

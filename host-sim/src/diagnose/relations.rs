@@ -1,0 +1,111 @@
+//! The log's windows and the parity relations it supports, and each relation's baseline:
+//! what the diagnosis's stages share. Identification and validation windows of each
+//! relation's length, thinned to [`MAX_FIT_S`] of the log; the hydraulic (eq. 6–11),
+//! mechanical (eq. 3–5), electrical (eq. 1–2, when the voltages are logged) and cylinder
+//! (eq. 12, when the piston moves) relations; and the orders the angle-locked lines are
+//! read at.
+
+use super::calibration::{thinned, Calibration, Patient, MAX_FIT_S};
+use super::cylinder::CylinderRelation;
+use super::electrical::ElectricalRelation;
+use super::facts::{rows_spanning, LogFacts};
+use super::hydraulic_relation::{HydraulicRelation, HYDRAULIC_WINDOW_S};
+use super::least_squares::{PATIENCE, THOROUGH_PATIENCE};
+use super::mechanical::ShaftMotion;
+use super::mechanical_relation::MechanicalRelation;
+use crate::bench_log::BenchLog;
+use plant_model::pump::ripple_order;
+use plant_model::Rig;
+use std::ops::Range;
+
+/// Length of the mechanical relation's calibration windows (thinned on long logs). [s]
+const MECHANICAL_WINDOW_S: f64 = 1.0;
+
+/// The orders the lines are read at: a current offset's p_n, flux harmonics' and dead
+/// time's 6·p_n, the pumps' 2z and the rig's slot order.
+pub(super) fn line_orders(rig: &Rig) -> Vec<u32> {
+    let pp = rig.motor.pole_pairs;
+    let mut v = vec![pp, 6 * pp, rig.motor.cogging_fundamental_order()];
+    v.extend(
+        super::candidates::RIPPLE_PISTONS
+            .iter()
+            .map(|z| ripple_order(*z)),
+    );
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// How far the fits are driven.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// Until the decision is settled: `eha diagnose`.
+    Diagnosis,
+    /// Until the fitted parameters stop moving: a feed-forward learned from them.
+    Learning,
+}
+
+/// The log's windows and the parity relations it supports.
+pub(super) struct Relations<'a> {
+    pub(super) h_id: Vec<Range<usize>>,
+    pub(super) h_val: Vec<Range<usize>>,
+    pub(super) m_id: Vec<Range<usize>>,
+    pub(super) m_val: Vec<Range<usize>>,
+    pub(super) hydraulic: HydraulicRelation<'a>,
+    pub(super) mechanical: MechanicalRelation<'a>,
+    pub(super) electrical: Option<ElectricalRelation<'a>>,
+    pub(super) cylinder: Option<CylinderRelation<'a>>,
+    pub(super) orders: Vec<u32>,
+    /// The optimiser's patience on every relation.
+    pub(super) patience: usize,
+}
+
+impl<'a> Relations<'a> {
+    pub(super) fn of(
+        log: &'a BenchLog,
+        facts: &'a LogFacts,
+        motion: &'a ShaftMotion,
+        rig: &'a Rig,
+        precision: Precision,
+    ) -> Relations<'a> {
+        let budget = rows_spanning(MAX_FIT_S, facts.period_s, 1);
+        let windows =
+            |rows, length, signal: &[f64]| thinned(facts.windows(rows, length), signal, budget);
+        let orders = line_orders(rig);
+        Relations {
+            h_id: windows(facts.identification(), HYDRAULIC_WINDOW_S, &log.p_pa),
+            h_val: windows(facts.validation(), HYDRAULIC_WINDOW_S, &log.p_pa),
+            m_id: windows(
+                facts.identification(),
+                MECHANICAL_WINDOW_S,
+                &log.speed_rad_s,
+            ),
+            m_val: windows(facts.validation(), MECHANICAL_WINDOW_S, &log.speed_rad_s),
+            hydraulic: HydraulicRelation { log, facts, rig },
+            mechanical: MechanicalRelation::new(log, facts, motion, rig, &orders),
+            electrical: ElectricalRelation::of(log, facts, rig),
+            cylinder: CylinderRelation::of(log, facts, rig),
+            orders,
+            patience: match precision {
+                Precision::Diagnosis => PATIENCE,
+                Precision::Learning => THOROUGH_PATIENCE,
+            },
+        }
+    }
+
+    /// `relation` fitted with the precision's patience.
+    pub(super) fn patient<'r, R>(&self, relation: &'r R) -> Patient<'r, R> {
+        Patient {
+            relation,
+            patience: self.patience,
+        }
+    }
+}
+
+/// Each relation's baseline, fitted within the tolerance bands.
+pub(super) struct Calibrations {
+    pub(super) hydraulic: Calibration,
+    pub(super) mechanical: Calibration,
+    pub(super) electrical: Option<Calibration>,
+    pub(super) cylinder: Option<Calibration>,
+}
