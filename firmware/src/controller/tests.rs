@@ -3,7 +3,10 @@
 //! built from the nominal scaling written out here.
 
 use super::*;
-use crate::supervisor::NotReady;
+use crate::config::Config;
+use crate::io::Measurements;
+use crate::parameters::ParamId;
+use crate::supervisor::{FaultCode, Mode, ModeRefusal, NotReady, Readiness};
 
 const A_PER_LSB: f32 = 100.0 / 4096.0;
 const PA_PER_LSB: f32 = 25e6 / 52428.8;
