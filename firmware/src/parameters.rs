@@ -5,7 +5,7 @@
 //!
 //! A parameter is read from and written into a [`Config`]; [`ParamId::set`] checks the
 //! value against the parameter's bounds first (so a refusal names the bound), then the
-//! rules of [`Config::validate`] that tie a parameter to other fields ([`cross_check`]:
+//! rules of [`Config::validate`] that tie a parameter to other fields ([`cross_check()`]:
 //! "the feedback filter must be at least twice the pressure bandwidth", "the over-current
 //! trip must exceed the q-current limit", …; a refusal names the conflicting field). The
 //! bounds contain every single-field rule of the validator, so bounds plus cross-check
@@ -73,6 +73,10 @@
 //! | 68 | `compensation.max_flow_ratio` | 1 | 0 | 0.5 | 0.1 |
 //!
 //! The table above is checked against the code by this module's tests.
+//!
+//! [`Config`]: crate::Config
+//! [`Config::validate`]: crate::Config::validate
+//! [`Config::nominal`]: crate::Config::nominal
 pub mod cross_check;
 pub mod id;
 pub mod table;

@@ -18,6 +18,8 @@ pub struct Status {
     /// Measured shaft speed. [0.1 rad/s]
     pub speed_drad_s: i16,
     /// Function code of the last accepted command, [`NO_COMMAND`] before the first.
+    ///
+    /// [`NO_COMMAND`]: super::wire::NO_COMMAND
     pub last_command: u8,
     /// Sequence counter.
     pub sequence: u8,

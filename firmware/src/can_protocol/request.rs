@@ -66,6 +66,8 @@ pub enum Request {
     /// One bin of the table being loaded.
     CompensationBin {
         /// Bin index (below [`COMPENSATION_HEADER_BIN`]).
+        ///
+        /// [`COMPENSATION_HEADER_BIN`]: super::wire::COMPENSATION_HEADER_BIN
         bin: u16,
         /// The three channels' raw values.
         raw: [i16; 3],

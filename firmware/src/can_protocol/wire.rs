@@ -3,6 +3,8 @@
 //! and range checks that turn SI values into wire integers ([`EncodeError`]).
 
 /// Highest mode code on the wire (the codes are the control core's [`Mode::code`]).
+///
+/// [`Mode::code`]: crate::supervisor::Mode::code
 pub const MODE_CODE_MAX: u8 = 3;
 
 /// Highest node number (the node occupies the identifier's low 4 bits).

@@ -55,6 +55,8 @@ pub enum Action {
         rad_s: f32,
     },
     /// Finished: the result is in [`Commissioning::result`].
+    ///
+    /// [`Commissioning::result`]: super::sequence::Commissioning::result
     Done,
     /// Failed with a fault code (13, 14 or 15).
     Fault(FaultCode),

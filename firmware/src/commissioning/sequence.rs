@@ -1,6 +1,6 @@
 //! The commissioning sequence's state machine: alignment sweeps and holds (encoder offset
 //! and direction), the two current levels (R_s), the spin (inertia and ψ_f) and the
-//! result with its gains; the inductance pulses are [`super::pulses`]. The steps and their
+//! result with its gains; the inductance pulses are in `pulses.rs`. The steps and their
 //! equations are in the [`super`] documentation.
 
 use super::config::CommissioningConfig;

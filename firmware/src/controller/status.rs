@@ -14,10 +14,12 @@ use crate::telemetry::TelemetryFrame;
 impl Controller {
     /// Replaces the whole live table (boot: the stored table, in
     /// [`ParamId::ALL`] order): every value checked against its bounds, the whole against
-    /// [`crate::parameters::cross_check`], then applied like [`Command::SetParameter`].
+    /// [`crate::parameters::cross_check()`], then applied like [`Command::SetParameter`].
     /// On a refusal nothing changes. Cheaper in flash than building the controller from a
     /// run-time configuration: [`Controller::new`] on the constant nominal configuration
     /// folds away at compile time.
+    ///
+    /// [`Command::SetParameter`]: super::command::Command::SetParameter
     pub fn load_parameters(&mut self, values: &[f32; COUNT]) -> Result<(), TableError> {
         parameters::apply_all(&mut self.cfg, values)?;
         self.retune(ParamId::EncoderOffset);
