@@ -24,6 +24,7 @@ pub mod current_loop;
 pub mod encoder;
 pub mod io;
 pub mod liveness;
+pub mod param_crc;
 pub mod param_store;
 pub mod parameters;
 pub mod pi;

@@ -62,15 +62,12 @@
 
 pub mod ecc;
 
+pub use crate::param_crc::CRC;
+
 use crate::compensation::record::{self as table_record, CHUNK_MAX};
 use crate::config::Config;
 use crate::parameters::{self, COUNT, LEGACY_COUNT};
-use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
 use embedded_storage::nor_flash::NorFlash;
-
-/// CRC-32 used for the record and the table fingerprint (bitwise: no 1 KiB lookup table in
-/// flash; a record is checked once per boot and save).
-pub const CRC: Crc<u32, NoTable> = Crc::<u32, NoTable>::new(&CRC_32_ISO_HDLC);
 
 /// Format version of the record; a record of another version is not loaded (version 2:
 /// the feed-forward table between the record and the commit word).

@@ -1,8 +1,15 @@
 //! The board: every pin, peripheral instance and clock of the NUCLEO-G474RE with a
 //! three-phase power stage, in one place. Porting to another board (or an STM32G431)
 //! changes this module only; the drivers in [`super::bridge`] and [`super::sensors`] take
-//! what [`init`] returns and the register blocks named here. `docs/bring-up.md` is the
-//! bench engineer's side of the same choices.
+//! what [`init`] returns and the register blocks named in [`regs`]. `docs/bring-up.md` is
+//! the bench engineer's side of the same choices.
+//!
+//! The board is the lowest layer of the application: it owns the peripherals and calls
+//! nothing above it (the application binds the current loop's vector). Its parts:
+//! [`regs`] (peripheral instances and register blocks), [`power_stage`] (TIM1, dead time,
+//! over-current trip, break inputs), [`breaks`] (break flags and latched break sources);
+//! this module brings everything up ([`init`]) and sets up the encoder, the clocks and
+//! the current loop's interrupt.
 //!
 //! # Pin and peripheral map (NUCLEO-G474RE)
 //!
@@ -56,64 +63,43 @@
 //! a debug halt freezes TIM1 with its outputs disabled (DBGMCU); a panic, a HardFault, a
 //! non-maskable interrupt or a stalled loop force a break in software
 //! ([`super::safe_state`]). Which source broke the bridge is kept even when it has gone
-//! again by the time the control interrupt looks ([`break_sources`]): the comparators'
+//! again by the time the control interrupt looks ([`breaks::break_sources`]): the comparators'
 //! outputs rising and the fault line falling set EXTI pending bits (lines 21, 29, 30 for
 //! COMP1, COMP3, COMP4; line 12 for PB12), which stay set until cleared.
+
+pub mod breaks;
+mod irqs;
+pub mod power_stage;
+pub mod regs;
 
 use embassy_stm32::adc::{Adc, AdcChannel as _, AdcConfig, Exten, InjectedAdc, SampleTime};
 use embassy_stm32::can::config::GlobalFilter;
 use embassy_stm32::can::filter::{Action, FilterType, StandardFilter, StandardFilterSlot};
-use embassy_stm32::can::{self, CanConfigurator};
-use embassy_stm32::comp::{self, Comp, Hysteresis, InvertingInput, OutputPolarity};
-use embassy_stm32::dac::{Dac, Value};
+use embassy_stm32::can::CanConfigurator;
 use embassy_stm32::flash::{Blocking, Flash};
-use embassy_stm32::gpio::OutputType::PushPull;
-use embassy_stm32::gpio::{AfType, Flex, Level, Output, Pull, Speed};
-use embassy_stm32::interrupt::{InterruptExt, Priority};
-use embassy_stm32::pac::timer::vals::Urs;
-use embassy_stm32::peripherals::{
-    ADC1, ADC2, COMP1, COMP3, COMP4, DAC3, FDCAN1, IWDG, PA0, PA1, PA10, PA15, PA8, PA9, PB0, PB10,
-    PB13, PB14, PB15, PB3, TIM1, TIM2,
-};
+use embassy_stm32::gpio::{Level, Output, Pull, Speed};
+use embassy_stm32::interrupt::{self, InterruptExt, Priority};
+use embassy_stm32::peripherals::{IWDG, PA15, PB10, PB3, TIM2};
 use embassy_stm32::time::Hertz;
-use embassy_stm32::timer::complementary_pwm::{
-    BreakComparatorPolarity, BreakInputPolarity, Ckd, ComplementaryPwm, ComplementaryPwmPin, Mms2,
-    Ossi, Ossr,
-};
 use embassy_stm32::timer::input_capture::CapturePin;
-use embassy_stm32::timer::low_level::{CountingMode, FilterValue};
+use embassy_stm32::timer::low_level::FilterValue;
 use embassy_stm32::timer::qei::{self, Qei, QeiMode};
-use embassy_stm32::timer::simple_pwm::PwmPin;
-use embassy_stm32::timer::{BkIn1, BreakInputPin, Ch3, Channel};
+use embassy_stm32::timer::Ch3;
 use embassy_stm32::wdg::IndependentWatchdog;
-use embassy_stm32::{bind_interrupts, interrupt, pac, triggers, Peri};
+use embassy_stm32::{pac, triggers, Peri};
 use firmware::can_protocol::{acceptance_filters, NodeId};
-use firmware::scaling::{centre_aligned_arr, centre_aligned_pwm_hz, comparator_threshold_counts};
 use firmware::Config;
 
-/// Timer of the power stage (advanced-control timer with complementary outputs).
-pub type PwmTimer = TIM1;
-/// ADC converting the phase currents and the DC link (interrupt source of the loop).
-pub type CurrentAdc = ADC1;
-/// ADC converting the pressure transducer.
-pub type PressureAdc = ADC2;
-/// Timer in encoder mode.
-pub type EncoderTimer = TIM2;
+use breaks::{clear_break_flags, clear_break_latches, latch_break_sources};
+use irqs::Irqs;
+use power_stage::{
+    break_input, enable_break, over_current_trip, power_stage, PowerStage, StageTiming,
+};
+use regs::{
+    CurrentAdc, EncoderTimer, PressureAdc, CURRENT_ADC_REGS, ENCODER_INDEX_CHANNEL, ENCODER_REGS,
+    PRESSURE_ADC_REGS,
+};
 
-/// Register block of [`PwmTimer`].
-pub const PWM_REGS: pac::timer::TimAdv = pac::TIM1;
-/// Register block of [`CurrentAdc`].
-pub const CURRENT_ADC_REGS: pac::adc::Adc = pac::ADC1;
-/// Register block of [`PressureAdc`].
-pub const PRESSURE_ADC_REGS: pac::adc::Adc = pac::ADC2;
-/// Register block of [`EncoderTimer`] (32-bit counter).
-pub const ENCODER_REGS: pac::timer::TimGp32 = pac::TIM2;
-/// Index of the encoder timer's channel that captures the index pulse (CH3).
-pub const ENCODER_INDEX_CHANNEL: usize = 2;
-
-/// Dead time between a phase's high- and low-side switch, set by the power stage's
-/// switches and gate driver. [s]
-pub const DEAD_TIME_S: f32 = 500e-9;
 /// CAN bit rate. [bit/s]
 pub const CAN_BITRATE: u32 = 500_000;
 /// Node number of this drive on the CAN bus (0‥15).
@@ -121,60 +107,10 @@ pub const CAN_NODE: u8 = 1;
 /// Independent-watchdog timeout. [µs]
 pub const WATCHDOG_TIMEOUT_US: u32 = 20_000;
 
-/// TIM1's break filter: 6 samples at f_DTS/8, 48 dead-time clocks (0.28 µs at 170 MHz,
-/// CKD = 1). Longer than the switching ringing a comparator on a shunt sees, far shorter
-/// than the 5‥10 µs a power switch survives a short circuit.
-const BREAK_FILTER: FilterValue = FilterValue::FDTS_DIV8_N6;
-/// [`BREAK_FILTER`] in dead-time clocks.
-const BREAK_FILTER_DTS_CLOCKS: u32 = 48;
 /// TIM2's input filter on A, B and Z: 8 samples at f_DTS/4, 32 timer clocks (0.19 µs at
 /// 170 MHz). Rejects glitches from the bridge's switching edges; passes the 1.05 µs
 /// between quadrature edges at the 600 rad/s plausibility limit (10 000 counts/rev).
 const ENCODER_FILTER: FilterValue = FilterValue::FDTS_DIV4_N8;
-/// The comparators of phases U, V, W as TIM1 break sources (BKCMPxE, x = index + 1):
-/// COMP3, COMP1, COMP4.
-const BREAK_COMPARATORS: [usize; 3] = [2, 0, 3];
-/// EXTI lines of the comparators of phases U, V, W (COMP3, COMP1, COMP4; RM0440, EXTI
-/// line connections).
-const COMPARATOR_EXTI_LINES: [usize; 3] = [29, 21, 30];
-/// EXTI line of the gate driver's fault line (PB12: line 12, port B selected in
-/// SYSCFG_EXTICR4).
-const FAULT_LINE_EXTI: usize = 12;
-/// SYSCFG_EXTICR port code of GPIOB.
-const EXTI_PORT_B: u8 = 1;
-
-bind_interrupts!(pub struct Irqs {
-    FDCAN1_IT0 => can::IT0InterruptHandler<FDCAN1>;
-    FDCAN1_IT1 => can::IT1InterruptHandler<FDCAN1>;
-    COMP1_2_3 => comp::InterruptHandler<COMP1>, comp::InterruptHandler<COMP3>;
-    COMP4_5_6 => comp::InterruptHandler<COMP4>;
-});
-
-/// The current-loop interrupt: ADC1 and ADC2 share this vector; only ADC1's
-/// end-of-injected-sequence interrupt is enabled.
-#[interrupt]
-fn ADC1_2() {
-    super::control::on_current_sample_interrupt();
-}
-
-/// The phase-current comparators into TIM1's break, and their thresholds (kept alive:
-/// dropping a driver disables its peripheral).
-pub struct OverCurrentTrip {
-    _u: Comp<'static, COMP3>,
-    _v: Comp<'static, COMP1>,
-    _w: Comp<'static, COMP4>,
-    _thresholds: Dac<'static, embassy_stm32::mode::Blocking>,
-}
-
-/// What the control interrupt owns.
-pub struct PowerStage {
-    /// TIM1 in complementary centre-aligned PWM.
-    pub pwm: ComplementaryPwm<'static, PwmTimer>,
-    /// The BKIN pin (kept alive so it stays in its alternate function).
-    pub _break_pin: Flex<'static>,
-    /// The hardware over-current trip.
-    pub _trip: OverCurrentTrip,
-}
 
 /// Sensor peripherals read by the control interrupt.
 pub struct SensorPeripherals {
@@ -186,24 +122,6 @@ pub struct SensorPeripherals {
     pub _encoder: Qei<'static, EncoderTimer>,
     /// The index pin (kept alive so it stays in its alternate function).
     pub _index_pin: CapturePin<'static, EncoderTimer, Ch3>,
-}
-
-/// The power stage's timing as set up, for the start-up log and the bench (a scope should
-/// show these numbers).
-#[derive(Clone, Copy, Debug, defmt::Format)]
-pub struct StageTiming {
-    /// TIM1's clock as the RCC reports it. [Hz]
-    pub timer_hz: u32,
-    /// TIM1's auto-reload value. [timer ticks]
-    pub arr: u16,
-    /// The PWM rate that gives: timer clock / (2·ARR). [Hz]
-    pub pwm_hz: f32,
-    /// Dead time the timer inserts. [ns]
-    pub dead_time_ns: u32,
-    /// Break filter delay. [ns]
-    pub break_filter_ns: u32,
-    /// DAC3 code of the comparators' threshold. [counts]
-    pub trip_code: u16,
 }
 
 /// Everything [`init`] brings up.
@@ -236,7 +154,7 @@ pub struct Board {
 pub fn init(pwm_hz: u32, cfg: &Config, node: NodeId) -> Board {
     let mut p = embassy_stm32::init(clock_config());
     let watchdog_reset = take_watchdog_reset();
-    super::safe_state::freeze_in_debug_halt();
+    freeze_in_debug_halt();
     // A core lockup (which no handler sees) and an uncorrectable flash ECC error break
     // TIM1 in hardware: SYSCFG_CFGR2.CLL and ECCL, set-only until the next reset. (The
     // SYSCFG clock is on: embassy's init enables it.)
@@ -362,274 +280,6 @@ pub fn init(pwm_hz: u32, cfg: &Config, node: NodeId) -> Board {
     }
 }
 
-/// TIM1 in complementary centre-aligned PWM with the outputs off and compare 0 (low sides
-/// on once MOE is set: the bootstrap precharge), both switches of every phase idle off,
-/// ARR and the repetition counter set with the counter stopped, the dead time from the
-/// timer clock the RCC reports, and the ADC trigger at the counter peak; returns the
-/// timing (the trip code still 0).
-fn power_stage(
-    tim: Peri<'static, TIM1>,
-    u: (Peri<'static, PA8>, Peri<'static, PB13>),
-    v: (Peri<'static, PA9>, Peri<'static, PB14>),
-    w: (Peri<'static, PA10>, Peri<'static, PB15>),
-    pwm_hz: u32,
-) -> (ComplementaryPwm<'static, TIM1>, StageTiming) {
-    // Pins first in their safe state, timer next, outputs disabled at once.
-    let mut pwm = ComplementaryPwm::new(
-        tim,
-        Some(PwmPin::new(u.0, PushPull)),
-        Some(ComplementaryPwmPin::new(u.1, PushPull)),
-        Some(PwmPin::new(v.0, PushPull)),
-        Some(ComplementaryPwmPin::new(v.1, PushPull)),
-        Some(PwmPin::new(w.0, PushPull)),
-        Some(ComplementaryPwmPin::new(w.1, PushPull)),
-        None,
-        None,
-        Hertz(pwm_hz),
-        CountingMode::CenterAlignedUpInterrupts,
-    );
-    pwm.set_master_output_enable(false);
-    // The driver has started the counter. Stop it, set ARR and RCR, load them (and the
-    // compare values below) with a software update, which also resets the counter and
-    // the repetition counter, then start it again: RCR written before the start puts the
-    // update events at the counter peak (see the module docs).
-    PWM_REGS.cr1().modify(|w| w.set_cen(false));
-    let timer_hz = embassy_stm32::rcc::frequency::<TIM1>().0;
-    let arr = match centre_aligned_arr(timer_hz, pwm_hz) {
-        Some(arr) => arr,
-        None => defmt::panic!("PWM at {} Hz is out of TIM1's range", pwm_hz),
-    };
-    PWM_REGS.psc().write_value(0);
-    PWM_REGS.arr().write(|w| w.set_arr(arr));
-    pwm.set_repetition_counter(1);
-    // MOE = 0 (software, break or debug halt): drive both gates of every phase to their
-    // idle level, which is "off" for both switches.
-    pwm.set_off_state_selection_idle(Ossi::IDLE_LEVEL);
-    pwm.set_off_state_selection_run(Ossr::IDLE_LEVEL);
-    // Idle level 0 on both outputs of every phase (the driver's `IdlePolarity` always
-    // makes one of the pair active, which would turn a switch on).
-    PWM_REGS.cr2().modify(|w| {
-        for ch in 0..3 {
-            w.set_ois(ch, false);
-            w.set_oisn(ch, false);
-        }
-    });
-    let dead_ticks = libm::roundf(DEAD_TIME_S * timer_hz as f32) as u16;
-    pwm.set_dead_time(dead_ticks);
-    for (k, ch) in [Channel::Ch1, Channel::Ch2, Channel::Ch3]
-        .into_iter()
-        .enumerate()
-    {
-        PWM_REGS.ccr(k).write(|w| w.set_ccr(0));
-        pwm.enable(ch);
-    }
-    // ADC trigger: OC4REF falls as the counter passes ARR − 1 on its way up.
-    PWM_REGS.ccr(3).write(|w| w.set_ccr(arr.saturating_sub(1)));
-    pwm.set_mms2(Mms2::COMPARE_OC4);
-    PWM_REGS.cr1().modify(|w| w.set_urs(Urs::COUNTER_ONLY));
-    PWM_REGS.egr().write(|w| w.set_ug(true));
-    PWM_REGS.cr1().modify(|w| {
-        w.set_urs(Urs::ANY_EVENT);
-        w.set_cen(true);
-    });
-
-    // What the timer really does, read back: the dead-time generator and the break filter
-    // both count the dead-time clock, the timer clock divided by CKD.
-    let ckd = match PWM_REGS.cr1().read().ckd() {
-        Ckd::DIV1 => 1,
-        Ckd::DIV2 => 2,
-        _ => 4,
-    };
-    let ns = |clocks: u32| (u64::from(clocks) * 1_000_000_000 / u64::from(timer_hz.max(1))) as u32;
-    let dead_clocks = dead_time_dts(PWM_REGS.bdtr().read().dtg()) * ckd;
-    let arr = PWM_REGS.arr().read().arr();
-    let timing = StageTiming {
-        timer_hz,
-        arr,
-        pwm_hz: centre_aligned_pwm_hz(timer_hz, arr),
-        dead_time_ns: ns(dead_clocks),
-        break_filter_ns: ns(BREAK_FILTER_DTS_CLOCKS * ckd),
-        trip_code: 0,
-    };
-    (pwm, timing)
-}
-
-/// Dead time of BDTR.DTG = `dtg`, in dead-time clocks (RM0440, TIMx_BDTR: four ranges).
-fn dead_time_dts(dtg: u8) -> u32 {
-    let dtg = u32::from(dtg);
-    match dtg >> 5 {
-        0..=3 => dtg,
-        4 | 5 => (64 + (dtg & 0x3F)) * 2,
-        6 => (32 + (dtg & 0x1F)) * 8,
-        _ => (32 + (dtg & 0x1F)) * 16,
-    }
-}
-
-/// The three phase comparators, each phase's amplified shunt signal against one DAC3
-/// threshold (COMP1 and COMP3 compare with DAC3 CH1, COMP4 with CH2, set to the same
-/// code). Low-side shunts see a phase's current while its low side conducts; a short or a
-/// shoot-through drives a large current *out of* the motor terminal through that switch,
-/// which reads far below the zero, so each comparator trips on a reading below
-/// `zero − limits.hardware_over_current_a` (output inverted: high = over-current). One
-/// comparator per phase leaves the opposite direction to the software trip (it shows on
-/// another phase's low side in the same period); a short from a motor terminal to the
-/// negative rail bypasses every shunt and is the gate driver's desaturation detection's
-/// to catch (its fault line is BKIN).
-fn over_current_trip(
-    comps: (
-        Peri<'static, COMP3>,
-        Peri<'static, COMP1>,
-        Peri<'static, COMP4>,
-    ),
-    u: Peri<'_, PA0>,
-    v: Peri<'_, PA1>,
-    w: Peri<'_, PB0>,
-    dac3: Peri<'static, DAC3>,
-    cfg: &Config,
-) -> (OverCurrentTrip, u16) {
-    let code = comparator_threshold_counts(
-        cfg.sensors.current_zero_lsb,
-        cfg.sensors.current_a_per_lsb,
-        cfg.limits.hardware_over_current_a,
-    );
-    let mut thresholds = Dac::<embassy_stm32::mode::Blocking>::new_internal(dac3);
-    thresholds.ch1().set(Value::Bit12Right(code));
-    thresholds.ch2().set(Value::Bit12Right(code));
-    let config = comp::Config {
-        inverting_input: InvertingInput::Dac1,
-        output_polarity: OutputPolarity::Inverted,
-        hysteresis: Hysteresis::Hyst20M,
-        ..comp::Config::default()
-    };
-    let trip = OverCurrentTrip {
-        _u: Comp::new(comps.0, u, Irqs, config),
-        _v: Comp::new(comps.1, v, Irqs, config),
-        _w: Comp::new(comps.2, w, Irqs, config),
-        _thresholds: thresholds,
-    };
-    (trip, code)
-}
-
-/// Arms TIM1's break: the gate driver's fault line (BKIN, active low) and the three
-/// comparators (active high) clear MOE within the break filter, independent of software;
-/// AOE off, so only software re-enables the bridge. Whatever the comparators and the DAC
-/// did while they started is cleared from the break flags before the control interrupt
-/// can see it; a fault still present at that point breaks again at once (the flags cannot
-/// be cleared while a break input is active, RM0440).
-fn enable_break(pwm: &mut ComplementaryPwm<'static, TIM1>) {
-    pwm.set_break_input_pin_enable(true);
-    pwm.set_break_polarity(BreakInputPolarity::ACTIVE_LOW);
-    for index in BREAK_COMPARATORS {
-        // Inverted against BKP = active low: a comparator output high breaks.
-        pwm.set_break_comparator_polarity(index, BreakComparatorPolarity::INVERTED);
-        pwm.set_break_comparator_enable(index, true);
-    }
-    pwm.set_break_filter(BREAK_FILTER);
-    pwm.set_automatic_output_enable(false);
-    // The DAC and the comparators settle in a few µs (DAC: ≤ 7.5 µs to its first output).
-    cortex_m::asm::delay(20 * 170);
-    clear_break_flags();
-    pwm.set_break_enable(true);
-}
-
-/// TIM1's break flags: `Some(system)` when a break has fired since they were cleared
-/// (TIM1_SR.BIF: break input, comparators, software; SBIF, `system`: core lockup or flash
-/// ECC error), `None` otherwise.
-#[inline]
-pub fn break_flags() -> Option<bool> {
-    let sr = PWM_REGS.sr().read();
-    (sr.bif(0) || sr.sbif()).then_some(sr.sbif())
-}
-
-/// Clears TIM1's break flags BIF and SBIF. TIM1_SR's flags are cleared by writing 0 and
-/// kept by writing 1 (rc_w0), so every other flag is written 1: a read-modify-write would
-/// clear a flag the hardware set between its read and its write.
-#[inline]
-pub fn clear_break_flags() {
-    let mut keep = pac::timer::regs::SrAdv(0);
-    keep.set_uif(true);
-    for n in 0..4 {
-        keep.set_ccif(n, true);
-        keep.set_ccof(n, true);
-    }
-    keep.set_comif(true);
-    keep.set_tif(true);
-    keep.set_bif(1, true);
-    keep.set_ccif5(true);
-    keep.set_ccif6(true);
-    keep.set_idxif(true);
-    keep.set_dirif(true);
-    keep.set_ierrif(true);
-    keep.set_terrif(true);
-    PWM_REGS.sr().write_value(keep);
-}
-
-/// Latches the break sources that may be gone by the time the control interrupt looks:
-/// the comparators' outputs rising (EXTI rising-edge triggers on their lines) and the
-/// gate driver's fault line falling (PB12 on EXTI line 12, falling edge). The lines are
-/// unmasked so the pending bits are set; their interrupts stay disabled in the NVIC.
-fn latch_break_sources() {
-    // The comparators' interrupt (enabled by their driver) is not used: its handler would
-    // mask the EXTI lines that latch the break sources. Off before the lines are unmasked.
-    interrupt::COMP1_2_3.disable();
-    interrupt::COMP4_5_6.disable();
-    // SYSCFG_EXTICR4 selects the port of lines 12‥15; line 12 is its first field.
-    pac::SYSCFG
-        .exticr(3)
-        .modify(|w| w.set_exti(FAULT_LINE_EXTI - 12, EXTI_PORT_B));
-    pac::EXTI.rtsr(0).modify(|w| {
-        for line in COMPARATOR_EXTI_LINES {
-            w.set_line(line, true);
-        }
-    });
-    pac::EXTI
-        .ftsr(0)
-        .modify(|w| w.set_line(FAULT_LINE_EXTI, true));
-    pac::EXTI.imr(0).modify(|w| {
-        for line in COMPARATOR_EXTI_LINES {
-            w.set_line(line, true);
-        }
-        w.set_line(FAULT_LINE_EXTI, true);
-    });
-    clear_break_latches();
-}
-
-/// Clears the latched break sources (EXTI_PR1 is cleared by writing 1 to a line's bit).
-pub fn clear_break_latches() {
-    pac::EXTI.pr(0).write(|w| {
-        for line in COMPARATOR_EXTI_LINES {
-            w.set_line(line, true);
-        }
-        w.set_line(FAULT_LINE_EXTI, true);
-    });
-}
-
-/// What broke the bridge, latched or still active: bit 0‥2 the comparators of phases
-/// U, V, W, bit 3 the gate driver's fault line, bit 4 a system break (`system`: core lockup
-/// or flash ECC error), bit 5 a non-maskable interrupt (`nmi`). None of them: a break
-/// forced by software (a stalled loop).
-pub fn break_sources(system: bool, nmi: bool) -> u8 {
-    let pending = pac::EXTI.pr(0).read();
-    let comparators = [pac::COMP3, pac::COMP1, pac::COMP4];
-    let mut bits = 0u8;
-    for (k, (c, line)) in comparators.iter().zip(COMPARATOR_EXTI_LINES).enumerate() {
-        if pending.line(line) || c.csr().read().value() {
-            bits |= 1 << k;
-        }
-    }
-    if pending.line(FAULT_LINE_EXTI) || pac::GPIOB.idr().read().idr(12) == pac::gpio::vals::Idr::LOW
-    {
-        bits |= 1 << 3;
-    }
-    if system {
-        bits |= 1 << 4;
-    }
-    if nmi {
-        bits |= 1 << 5;
-    }
-    bits
-}
-
 /// The encoder: x4 quadrature on TIM2, wrapping once per revolution, the index pulse
 /// captured on CH3 (the capture flag is polled by the control interrupt), a digital filter
 /// on all three inputs.
@@ -723,11 +373,14 @@ fn clock_config() -> embassy_stm32::Config {
     config
 }
 
-/// Puts a TIM1 break-input pin in its alternate function with a pull-up (an open-drain
-/// fault line reads "no fault" when released).
-fn break_input<P: BreakInputPin<PwmTimer, BkIn1>>(pin: Peri<'static, P>) -> Flex<'static> {
-    let af = pin.af_num();
-    let mut flex = Flex::new(pin);
-    flex.set_as_af_unchecked(af, AfType::input(Pull::Up));
-    flex
+/// Stops TIM1 (outputs disabled), TIM15 (the executor's clock) and the independent
+/// watchdog while the core is halted by a debugger (the safe state of a debug halt,
+/// [`super::safe_state`]). The encoder timer (TIM2) runs on, so a shaft turned during the
+/// halt is still counted.
+fn freeze_in_debug_halt() {
+    pac::DBGMCU.apb2fzr().modify(|w| {
+        w.set_tim1(true);
+        w.set_tim15(true);
+    });
+    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
 }

@@ -12,7 +12,9 @@
 //! charges the bootstrap capacitors; the sequence, its break handling and MOE tracked in
 //! software are the hardware-free [`firmware::bridge::BridgeControl`], tested on the host.
 
-use super::board::{self, PowerStage as Stage, PWM_REGS};
+use super::board::breaks::{break_flags, clear_break_flags};
+use super::board::power_stage::PowerStage as Stage;
+use super::board::regs::PWM_REGS;
 use firmware::bridge::{BridgeControl, PowerStage};
 use firmware::Outputs;
 
@@ -28,7 +30,7 @@ struct Registers {
 impl PowerStage for Registers {
     #[inline]
     fn break_flagged(&mut self) -> bool {
-        match board::break_flags() {
+        match break_flags() {
             Some(system) => {
                 self.system_break |= system;
                 true
@@ -39,7 +41,7 @@ impl PowerStage for Registers {
 
     #[inline]
     fn clear_break_flags(&mut self) {
-        board::clear_break_flags();
+        clear_break_flags();
     }
 
     #[inline]

@@ -13,7 +13,7 @@
 //! [`isr_count`], read by the supervision task. A hardware break (gate-driver fault line,
 //! phase comparator, system break, or a break forced by [`super::safe_state`]) latches
 //! fault 17; its sources, latched by the board even when they have gone again
-//! ([`board::break_sources`]), are kept for the supervision task's log
+//! ([`break_sources`]), are kept for the supervision task's log
 //! ([`last_break_sources`]).
 //!
 //! Telemetry is captured here, every `telemetry_decimation` periods exactly: the frame
@@ -30,7 +30,8 @@ use embassy_sync::blocking_mutex::CriticalSectionMutex;
 use embassy_sync::channel::Channel;
 use firmware::{Controller, TelemetryFrame};
 
-use super::board::{self, CURRENT_ADC_REGS};
+use super::board::breaks::{break_sources, clear_break_latches};
+use super::board::regs::CURRENT_ADC_REGS;
 use super::bridge::{Bridge, BridgeEvent};
 use super::safe_state;
 use super::sensors::Sensors;
@@ -125,7 +126,7 @@ pub fn breaks() -> u32 {
     BREAKS.load(Ordering::Relaxed)
 }
 
-/// The break sources active when the last break was seen ([`board::break_sources`]).
+/// The break sources active when the last break was seen ([`break_sources`]).
 pub fn last_break_sources() -> u8 {
     BREAK_SOURCES.load(Ordering::Relaxed) as u8
 }
@@ -140,7 +141,7 @@ pub async fn next_telemetry_frame() -> TelemetryFrame {
     TELEMETRY.receive().await
 }
 
-/// The interrupt body (called from the vector in the board module).
+/// The interrupt body (called from the vector the application binds, `ADC1_2`).
 pub fn on_current_sample_interrupt() {
     let start = DWT::cycle_count();
     DRIVE.lock(|d| {
@@ -167,15 +168,15 @@ impl Drive {
             let nmis = safe_state::nmis();
             let nmi = nmis != self.nmis_seen;
             self.nmis_seen = nmis;
-            let sources = board::break_sources(system, nmi);
-            board::clear_break_latches();
+            let sources = break_sources(system, nmi);
+            clear_break_latches();
             BREAK_SOURCES.store(u32::from(sources), Ordering::Relaxed);
             BREAKS.fetch_add(1, Ordering::Relaxed);
             self.controller.report_hardware_break();
         } else if !was_on && self.bridge.enabled() {
             // A fresh enable: what the latches caught meanwhile (a comparator pulse shorter
             // than the break filter) belongs to no break.
-            board::clear_break_latches();
+            clear_break_latches();
         }
         self.telemetry_countdown = self.telemetry_countdown.saturating_sub(1);
         if self.telemetry_countdown == 0 {

@@ -2,10 +2,12 @@
 //! peripherals of the NUCLEO-G474RE.
 //!
 //! - [`board`]: every pin, peripheral instance and clock (the one module to change for
-//!   another board), the hardware over-current trip, and the interrupt vector of the
-//!   current loop.
+//!   another board), the power stage with the hardware over-current trip, and the break
+//!   latches; it calls nothing above it.
 //! - [`control`]: the current-loop interrupt (highest priority, not a task) and the state
-//!   it shares with the tasks; [`bridge`] and [`sensors`] are its drivers.
+//!   it shares with the tasks; [`bridge`] and [`sensors`] are its drivers over the
+//!   board's register blocks. This module joins them: it binds the interrupt vector
+//!   (`ADC1_2`) to [`control`] and hands the board's peripherals to the drivers.
 //! - [`safe_state`]: the bridge off on a panic, a HardFault, an NMI (a flash ECC error), a
 //!   core lockup, a debug halt or a stall.
 //! - [`param_flash`]: the parameter table at the end of flash bank 2.
@@ -40,6 +42,7 @@ mod telemetry;
 
 use defmt_rtt as _;
 use embassy_executor::Spawner;
+use embassy_stm32::interrupt;
 use embassy_time::Timer;
 use firmware::can_protocol::NodeId;
 use firmware::compensation::CompensationError;
@@ -120,6 +123,13 @@ async fn main(spawner: Spawner) {
     spawner.spawn(unwrap_spawn(can_link::transmit(sender, node)));
     spawner.spawn(unwrap_spawn(telemetry::run()));
     spawner.spawn(unwrap_spawn(supervision::run(b.watchdog, b.led, pwm_hz)));
+}
+
+/// The current-loop interrupt: ADC1 and ADC2 share this vector; only ADC1's
+/// end-of-injected-sequence interrupt is enabled ([`board::enable_current_loop_interrupt`]).
+#[interrupt]
+fn ADC1_2() {
+    control::on_current_sample_interrupt();
 }
 
 /// Opens the parameter store and applies its table to `controller`; latches fault 16 for

@@ -5,7 +5,7 @@
 //!   interrupt, which latches fault 17 if it ever runs again. AOE is off, so only software
 //!   sets MOE again. Used by the panic handler, the HardFault handler, the NMI handler and
 //!   the supervision task when the current loop stalls.
-//! - A debug halt ([`freeze_in_debug_halt`]): DBGMCU stops TIM1 with the core, and an
+//! - A debug halt (set up by `board::init`): DBGMCU stops TIM1 with the core, and an
 //!   advanced timer stopped in debug disables its outputs as if MOE were cleared; the
 //!   independent watchdog stops too, so a breakpoint does not end in a reset; and TIM15,
 //!   the executor's clock, stops, so the time the supervision task measures excludes the
@@ -36,7 +36,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m_rt::{exception, ExceptionFrame};
 use embassy_stm32::pac;
 
-use super::board::PWM_REGS;
+use super::board::regs::PWM_REGS;
 
 /// Uncorrectable flash ECC errors so far (wraps).
 static ECC_ERRORS: AtomicU32 = AtomicU32::new(0);
@@ -50,17 +50,6 @@ static NMIS: AtomicU32 = AtomicU32::new(0);
 #[inline(always)]
 pub fn force_break() {
     PWM_REGS.egr().write(|w| w.set_bg(0, true));
-}
-
-/// Stops TIM1 (outputs disabled), TIM15 (the executor's clock) and the independent
-/// watchdog while the core is halted by a debugger. The encoder timer (TIM2) runs on, so
-/// a shaft turned during the halt is still counted.
-pub fn freeze_in_debug_halt() {
-    pac::DBGMCU.apb2fzr().modify(|w| {
-        w.set_tim1(true);
-        w.set_tim15(true);
-    });
-    pac::DBGMCU.apb1lfzr().modify(|w| w.set_iwdg(true));
 }
 
 /// Uncorrectable flash ECC errors the NMI handler has counted so far (wrapping), after

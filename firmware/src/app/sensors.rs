@@ -11,7 +11,8 @@
 //! pressure conversion outlasts the period and only every other trigger is converted; the
 //! value is then two periods old.)
 
-use super::board::{SensorPeripherals, ENCODER_INDEX_CHANNEL, ENCODER_REGS};
+use super::board::regs::{ENCODER_INDEX_CHANNEL, ENCODER_REGS};
+use super::board::SensorPeripherals;
 use firmware::Measurements;
 
 /// The sensor driver.

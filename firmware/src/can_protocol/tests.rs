@@ -2,7 +2,9 @@
 //! and every malformed frame refused with its reason.
 
 use super::*;
-use crate::supervisor::{FaultCode, NotReady};
+use crate::controller::{Command, CommandError};
+use crate::step_test::StepLoop;
+use crate::supervisor::{FaultCode, Mode, ModeRefusal, NotReady};
 
 fn node(n: u8) -> NodeId {
     NodeId::new(n).expect("valid node")

@@ -2,7 +2,7 @@
 //! voltage, the spin, the loop designs the gains are derived for, and the plausibility
 //! window. Validated once with the rest of [`crate::Config`].
 
-use crate::config::ConfigError;
+use crate::config::error::ConfigError;
 
 /// Commissioning sequence settings.
 #[derive(Clone, Copy, Debug, PartialEq)]

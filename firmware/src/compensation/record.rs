@@ -8,8 +8,8 @@
 //! |--------|------|---------------------------------------------------------------|
 //! | 0      | 4    | magic `0x5443_4845` (bytes `E H C T`)                         |
 //! | 4      | 2    | format version ([`VERSION`])                                  |
-//! | 6      | 2    | bins per revolution ([`super::BINS`])                         |
-//! | 8      | 1    | channels ([`super::CHANNELS`])                                |
+//! | 6      | 2    | bins per revolution ([`super::table::BINS`])                         |
+//! | 8      | 1    | channels ([`super::table::CHANNELS`])                                |
 //! | 9      | 1    | reserved, 0                                                   |
 //! | 10     | 3    | LSB exponent e per channel (`i8`, 0‥=100): value = raw · 2^−e |
 //! | 13     | 3    | reserved, 0                                                   |
@@ -25,7 +25,7 @@
 //! that carries them: the host sends the CRC of the file it wrote, so a lost, repeated or
 //! corrupted frame fails the commit.
 
-use super::{Exponent, Table, BINS, CHANNELS};
+use super::table::{Exponent, Table, BINS, CHANNELS, MAX_EXPONENT};
 use core::fmt;
 use crc::{Crc, Digest, NoTable, CRC_32_ISO_HDLC};
 
@@ -77,7 +77,7 @@ pub enum RecordError {
         /// The record's channel count.
         found: u8,
     },
-    /// An LSB exponent outside 0‥=[`super::MAX_EXPONENT`].
+    /// An LSB exponent outside 0‥=[`MAX_EXPONENT`].
     Exponent {
         /// Its channel.
         channel: u8,
@@ -143,7 +143,7 @@ impl fmt::Display for RecordError {
             RecordError::Exponent { channel, found } => write!(
                 f,
                 "channel {channel}'s LSB exponent {found} outside 0..={}",
-                super::MAX_EXPONENT
+                MAX_EXPONENT
             ),
             RecordError::Crc { stored, computed } => write!(
                 f,
@@ -198,7 +198,7 @@ fn parse_header(h: &[u8; HEADER_LEN]) -> Result<[Exponent; CHANNELS], RecordErro
 fn check_exponents(exponents: [Exponent; CHANNELS]) -> Result<(), RecordError> {
     match exponents
         .iter()
-        .position(|e| !(0..=super::MAX_EXPONENT).contains(e))
+        .position(|e| !(0..=MAX_EXPONENT).contains(e))
     {
         Some(c) => Err(RecordError::Exponent {
             channel: c as u8,

@@ -4,7 +4,8 @@
 //! current gains as soon as they exist and, at the end, the identified encoder offset and
 //! machine constants.
 
-use super::{Calibration, Controller};
+use super::calibration_state::Calibration;
+use super::drive::Controller;
 use crate::commissioning::{Action, Input};
 use crate::io::Measurements;
 use crate::supervisor::{FaultCode, Mode};

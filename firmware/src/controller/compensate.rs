@@ -2,7 +2,8 @@
 //! loading (CAN, flash, host), the amplitude limit held against every change of table,
 //! scale or limit, and the bench sweep ([`crate::sweep`]).
 
-use super::{Command, CommandError, Controller};
+use super::command::{Command, CommandError};
+use super::drive::Controller;
 use crate::compensation::{Compensation, CompensationError, Table};
 use crate::config::Config;
 use crate::parameters::{ParamError, ParamId};

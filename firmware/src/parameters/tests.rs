@@ -3,7 +3,7 @@
 //! with the bound it violates.
 
 use super::*;
-use crate::config::ConfigError;
+use crate::config::{Config, ConfigError};
 
 /// A number as written in the module's table: plain decimal, or `e` notation below 1e-7
 /// (where plain decimals become unreadable).
