@@ -21,7 +21,8 @@
 //!
 //! `cargo xtask fw-size` does step 5 alone, `cargo xtask pil` step 6, `cargo xtask can`
 //! step 4, `cargo xtask fleet` the fleet check of step 3; `cargo xtask dbc [--node N]
-//! [--out FILE]` writes the DBC file.
+//! [--out FILE]` writes the DBC file; `cargo xtask rooms` lists the files over 650 lines and
+//! the import circles between files ([`rooms`]).
 
 use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
@@ -32,6 +33,7 @@ mod can_check;
 mod dbc;
 mod fleet_check;
 mod pil;
+mod rooms;
 mod setup;
 mod watch_check;
 
@@ -52,11 +54,12 @@ fn main() {
             .and_then(|()| setup::tools())
             .and_then(|()| pil::pil()),
         Some("dbc") => dbc::dbc(&args[1..]),
+        Some("rooms") => rooms::rooms(&args[1..]),
         Some("can") => can(),
         Some("fleet") => setup::python().and_then(|p| fleet_check::check(&p)),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test | fw-size | pil | can | fleet | dbc [--node N] [--out FILE]>"
+                "usage: cargo xtask <test | fw-size | pil | can | fleet | rooms | dbc [--node N] [--out FILE]>"
             );
             std::process::exit(2);
         }
