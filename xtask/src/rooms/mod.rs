@@ -37,7 +37,7 @@ pub fn rooms(args: &[String]) -> Result<()> {
     if let Some(a) = args.first() {
         bail!("rooms: unknown argument `{a}` (it takes none)");
     }
-    let root = crate::root();
+    let root = crate::workspace::root();
     let srcs: Vec<_> = SOURCES.iter().map(|s| root.join(s)).collect();
     let found = findings::check(&srcs, LINE_LIMIT)?;
     print!("{}", report::text(&found, &root, LINE_LIMIT));
