@@ -52,7 +52,7 @@ fn main() {
         Some("fleet") => setup::python().and_then(|p| fleet_check::check(&p)),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test | fw-size | pil | can | fleet | rooms | dbc [--node N] [--out FILE]>"
+                "usage: cargo xtask <test | fw-size | pil | can | fleet | rooms [--root DIR] | dbc [--node N] [--out FILE]>"
             );
             std::process::exit(2);
         }
