@@ -234,3 +234,24 @@ fn tarjan_finds_each_cycle_and_leaves_out_single_nodes() {
         vec![vec![0, 1, 2], vec![3, 4]]
     );
 }
+
+#[test]
+fn only_test_only_configurations_count_as_tests() {
+    let attrs = |text: &str| {
+        syn::parse_str::<syn::ItemFn>(&format!("{text} fn f() {{}}"))
+            .unwrap()
+            .attrs
+    };
+    assert!(super::modules::is_test(&attrs("#[cfg(test)]")));
+    assert!(super::modules::is_test(&attrs(
+        "#[cfg(all(test, feature = \"std\"))]"
+    )));
+    assert!(!super::modules::is_test(&attrs("#[cfg(not(test))]")));
+    assert!(!super::modules::is_test(&attrs(
+        "#[cfg(any(test, feature = \"std\"))]"
+    )));
+    assert!(!super::modules::is_test(&attrs(
+        "#[cfg(feature = \"test\")]"
+    )));
+    assert!(!super::modules::is_test(&attrs("#[inline]")));
+}
