@@ -399,17 +399,17 @@ pub fn check(python: &std::path::Path) -> Result<()> {
             })
         })
         .collect();
-    let dir = crate::target_dir().join("can-check");
+    let dir = crate::workspace::target_dir().join("can-check");
     std::fs::create_dir_all(&dir)?;
     let input = dir.join("firmware-frames.json");
     let output = dir.join("cantools-frames.json");
     std::fs::write(&input, serde_json::to_string_pretty(&vectors)?)?;
     let _ = std::fs::remove_file(&output);
-    crate::run(
+    crate::workspace::run(
         "CAN: cantools against the firmware's codec",
         Command::new(python)
-            .arg(crate::root().join("xtask").join("can_check.py"))
-            .arg(crate::root().join(crate::dbc::FILE))
+            .arg(crate::workspace::root().join("xtask").join("can_check.py"))
+            .arg(crate::workspace::root().join(crate::dbc::FILE))
             .arg(&input)
             .arg(&output),
     )?;

@@ -97,13 +97,13 @@ fn json_rows(path: &Path) -> Result<Vec<Value>> {
 
 /// Runs the check with the Python interpreter `python`.
 pub fn check(python: &Path) -> Result<()> {
-    let root = crate::root();
-    crate::run(
+    let root = crate::workspace::root();
+    crate::workspace::run(
         "eha for the fleet check",
-        crate::cargo().args(["build", "-p", "host-sim", "--bin", "eha"]),
+        crate::workspace::cargo().args(["build", "-p", "host-sim", "--bin", "eha"]),
     )?;
-    let eha = crate::target_dir().join("debug").join("eha");
-    let base = crate::target_dir().join("fleet-check");
+    let eha = crate::workspace::target_dir().join("debug").join("eha");
+    let base = crate::workspace::target_dir().join("fleet-check");
     let _ = fs::remove_dir_all(&base);
     let logs = base.join("logs");
     fs::create_dir_all(&logs)?;

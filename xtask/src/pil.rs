@@ -43,9 +43,9 @@ pub fn pil() -> Result<()> {
              `apt-get update` first on a fresh machine)"
         );
     }
-    crate::run(
+    crate::workspace::run(
         "PIL image (warnings denied)",
-        crate::cargo().args([
+        crate::workspace::cargo().args([
             "build",
             "--release",
             "--package",
@@ -53,13 +53,19 @@ pub fn pil() -> Result<()> {
             "--bin",
             "pil",
             "--target",
-            crate::TARGET,
+            crate::firmware_image::TARGET,
             "--config",
-            &format!("target.{}.rustflags=[\"-D\", \"warnings\"]", crate::TARGET),
+            &format!(
+                "target.{}.rustflags=[\"-D\", \"warnings\"]",
+                crate::firmware_image::TARGET
+            ),
         ]),
     )?;
-    let target_dir = crate::target_dir();
-    let elf = target_dir.join(crate::TARGET).join("release").join("pil");
+    let target_dir = crate::workspace::target_dir();
+    let elf = target_dir
+        .join(crate::firmware_image::TARGET)
+        .join("release")
+        .join("pil");
     let out_dir = target_dir.join("pil");
     fs::create_dir_all(&out_dir)?;
 
@@ -83,7 +89,7 @@ pub fn pil() -> Result<()> {
 
     let pil_csv = out_dir.join("pil.csv");
     let host_csv = out_dir.join("host.csv");
-    crate::run(
+    crate::workspace::run(
         "eha ingest (PIL telemetry)",
         eha().args([
             "ingest",
@@ -92,9 +98,9 @@ pub fn pil() -> Result<()> {
             path_str(&pil_csv)?,
         ]),
     )?;
-    let eha_bin = crate::target_dir().join("debug").join("eha");
+    let eha_bin = crate::workspace::target_dir().join("debug").join("eha");
     crate::watch_check::check(&eha_bin, &defmt_log, &pil_csv, &out_dir)?;
-    crate::run(
+    crate::workspace::run(
         "eha simulate (same scenario on the host)",
         eha().args([
             "simulate",
@@ -117,7 +123,8 @@ pub fn pil() -> Result<()> {
     let stack_peak = figure(&figures, "stack_peak_bytes")?;
     // The check holds the run to the stack the budget guarantees the firmware (its RAM
     // less the static-RAM budget); the image's own figure is reported beside it.
-    let firmware_stack_min = (crate::FIRMWARE_RAM - crate::RAM_BUDGET) as f64;
+    let firmware_stack_min =
+        (crate::firmware_image::FIRMWARE_RAM - crate::firmware_image::RAM_BUDGET) as f64;
     let firmware_stack = firmware_stack_bytes();
     let stack_margin = firmware_stack_min / stack_peak.max(1.0);
     let report = serde_json::json!({
@@ -195,8 +202,8 @@ pub fn pil() -> Result<()> {
 /// it), when the image has been built. [bytes]
 fn firmware_stack_bytes() -> Option<u64> {
     use object::{Object, ObjectSymbol};
-    let elf = crate::target_dir()
-        .join(crate::TARGET)
+    let elf = crate::workspace::target_dir()
+        .join(crate::firmware_image::TARGET)
         .join("release")
         .join("firmware");
     let data = fs::read(elf).ok()?;
@@ -211,7 +218,7 @@ fn firmware_stack_bytes() -> Option<u64> {
 
 /// `eha` from the workspace (the host tests have already built it).
 fn eha() -> Command {
-    let mut c = crate::cargo();
+    let mut c = crate::workspace::cargo();
     c.args([
         "run",
         "--quiet",
@@ -346,7 +353,7 @@ fn figure(figures: &BTreeMap<String, f64>, key: &str) -> Result<f64> {
 
 /// The recorded current-loop budget and the goal, from `pil/budget.toml`. [instructions]
 fn budget() -> Result<(f64, f64)> {
-    let path = crate::root().join("pil").join("budget.toml");
+    let path = crate::workspace::root().join("pil").join("budget.toml");
     let text = fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let table: toml::Table = text
         .parse()

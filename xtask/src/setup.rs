@@ -41,8 +41,8 @@ fn apt_install(packages: &[&str]) -> Result<()> {
             packages.join(", ")
         );
     }
-    crate::run("apt-get update", Command::new("apt-get").arg("update"))?;
-    crate::run(
+    crate::workspace::run("apt-get update", Command::new("apt-get").arg("update"))?;
+    crate::workspace::run(
         "apt-get install",
         Command::new("apt-get")
             .args(["install", "-y", "--no-install-recommends"])
@@ -62,7 +62,7 @@ pub fn linker() -> Result<()> {
         .status()
         .is_ok_and(|s| s.success());
     if !installed {
-        crate::run(
+        crate::workspace::run(
             "install flip-link (the Cortex-M images' linker)",
             Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())).args([
                 "install",
@@ -115,7 +115,7 @@ pub fn python() -> Result<PathBuf> {
         }
         return Ok(p);
     }
-    let venv = crate::target_dir().join("py-venv");
+    let venv = crate::workspace::target_dir().join("py-venv");
     let python = venv.join("bin").join("python");
     if has_packages(&python) {
         return Ok(python);
@@ -134,11 +134,15 @@ pub fn python() -> Result<PathBuf> {
             bail!("python3 -m venv {} failed", venv.display());
         }
     }
-    crate::run(
+    crate::workspace::run(
         "cantools, dask and distributed into the checks' virtual environment",
         Command::new(&python)
             .args(["-m", "pip", "install", "--quiet", "-r"])
-            .arg(crate::root().join("xtask").join("requirements.txt")),
+            .arg(
+                crate::workspace::root()
+                    .join("xtask")
+                    .join("requirements.txt"),
+            ),
     )
     .context("installing the checks' Python packages with pip")?;
     if !has_packages(&python) {

@@ -1,0 +1,53 @@
+//! `cargo xtask rooms`: the files over 650 lines and the import circles between files of
+//! the product's crates (`firmware`, `plant-model`, `host-sim`, `closed-loop`, `xtask`).
+//! An edge runs from file A to file B when A uses an item B defines (through `use`,
+//! a `crate::`/`super::`/`self::` path, or a re-export followed to the defining file); a
+//! circle is a strongly connected component of more than one file. Test-only code is left
+//! out. Exits non-zero when either list is non-empty. `--root DIR` checks another checkout.
+//!
+//! Files are found by [`discovery`], parsed into module trees by [`modules`], their paths
+//! resolved to edges by [`resolve`], the circles found by [`graph`] and gathered in
+//! [`findings`], the text written by [`report`].
+
+mod discovery;
+mod findings;
+mod graph;
+mod modules;
+mod report;
+mod resolve;
+#[cfg(test)]
+mod tests;
+
+use anyhow::{bail, Result};
+
+/// The crates' source folders, relative to the workspace root.
+pub const SOURCES: [&str; 5] = [
+    "firmware/src",
+    "plant-model/src",
+    "host-sim/src",
+    "closed-loop/src",
+    "xtask/src",
+];
+
+/// A file longer than this is reported (the guide aims at 600).
+pub const LINE_LIMIT: usize = 650;
+
+/// `cargo xtask rooms [--root DIR]`: this workspace, or the checkout at `DIR`.
+pub fn rooms(args: &[String]) -> Result<()> {
+    let root = match args {
+        [] => crate::workspace::root(),
+        [flag, dir] if flag == "--root" => std::path::PathBuf::from(dir),
+        _ => bail!("rooms: usage: cargo xtask rooms [--root DIR]"),
+    };
+    let srcs: Vec<_> = SOURCES.iter().map(|s| root.join(s)).collect();
+    let found = findings::check(&srcs, LINE_LIMIT)?;
+    print!("{}", report::text(&found, &root, LINE_LIMIT));
+    if !found.clean() {
+        bail!(
+            "rooms: {} file(s) over {LINE_LIMIT} lines and {} import circle(s) (listed above)",
+            found.long_files.len(),
+            found.circles.len()
+        );
+    }
+    Ok(())
+}
