@@ -2,8 +2,11 @@
 //! pump's flow-ripple modulation, [`super::flow`]) and their single-field rules; the
 //! amplitude bound against the other sections is [`super::Compensation::check_amplitude`].
 
-use super::flow;
 use crate::config::error::ConfigError;
+
+/// Fewest pistons the closed form holds for (z = 1 and 2 are not a cosine cap of half
+/// width ≤ π/4). [1]
+pub const MIN_PISTONS: u32 = 3;
 
 /// The feed-forward's live parameters (ids 60–62 of [`crate::parameters`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -15,7 +18,7 @@ pub struct CompensationConfig {
     /// Largest amplitude the feed-forward may reach over the operating range. [A]
     pub max_current_a: f32,
     /// Pistons z of the pump whose flow ripple the speed modulation cancels ([`flow`];
-    /// 0: no modulation, else at least [`flow::MIN_PISTONS`]). [1]
+    /// 0: no modulation, else at least [`MIN_PISTONS`]). [1]
     pub flow_pistons: u32,
     /// The pump's flow ripple, peak-to-peak over the mean flow (0: no modulation). [1]
     pub flow_ratio: f32,
@@ -57,7 +60,7 @@ impl CompensationConfig {
                 problem: "must be within 0..=10",
             });
         }
-        if self.flow_pistons > 31 || (1..flow::MIN_PISTONS).contains(&self.flow_pistons) {
+        if self.flow_pistons > 31 || (1..MIN_PISTONS).contains(&self.flow_pistons) {
             return Err(ConfigError {
                 field: "compensation.flow_pistons",
                 problem: "must be 0 (off) or within 3..=31",

@@ -49,9 +49,7 @@ use crate::commissioning::gains::torque_constant;
 use crate::pi::saturate;
 use core::f32::consts::PI;
 
-/// Fewest pistons the closed form holds for (z = 1 and 2 are not a cosine cap of half
-/// width ≤ π/4). [1]
-pub const MIN_PISTONS: u32 = 3;
+pub use super::config::MIN_PISTONS;
 
 /// Ripple cycles per revolution: 2z for odd z, z for even z. [1]
 pub fn ripple_order(z: u32) -> u32 {
