@@ -6,8 +6,8 @@
 //! A test generator draws the parameters and builds its scenario with these functions; the
 //! named defaults in [`crate::SCENARIOS`] are the same functions at fixed values.
 
+use crate::plan::{Scenario, ScenarioKind, MAX_EVENTS};
 use crate::profile::{Profile, ProfileError, Setpoint, Sine};
-use crate::scenario::{Scenario, ScenarioKind, MAX_EVENTS};
 use firmware::{Command, Mode};
 
 /// Where every test starts: chamber A at the boost pressure, at rest. [Pa]

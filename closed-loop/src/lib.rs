@@ -19,12 +19,14 @@
 pub mod bench_test;
 pub mod commissioning;
 pub mod config;
+pub mod plan;
 pub mod profile;
 pub mod scenario;
 
 pub use config::controller_config;
+pub use plan::{Scenario, ScenarioKind};
 pub use profile::{Profile, Setpoint};
-pub use scenario::{by_name, Scenario, ScenarioKind, PROCEDURES, SCENARIOS};
+pub use scenario::{by_name, PROCEDURES, SCENARIOS};
 
 use firmware::io::{Measurements, Outputs};
 use firmware::{Command, Controller};

@@ -17,7 +17,10 @@
 //! step, so its crossing instant is solved for exactly; slower currents are checked at the
 //! step's end.
 
-use super::{ix, Drive, Inputs, Plant};
+use super::actuator::Plant;
+use super::inputs::{Drive, Inputs};
+use super::protection::CurrentWatch;
+use super::state::{ix, Vector};
 use crate::faults::{
     burst_flow, fault_path_current, fault_path_voltage, leg_contribution, line_current,
     line_derivatives, rotor_projections, Line, PlantFaults, ShortPath,
@@ -28,32 +31,6 @@ use crate::sensor_faults::SensorFaults;
 
 /// √3.
 const SQRT3: f64 = 1.732_050_807_568_877_2;
-
-/// The hardware break and the current watch.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Protection {
-    /// Break threshold on any leg current's magnitude. [A]
-    break_threshold_a: Option<f64>,
-    /// Gates held off by the break.
-    latched: bool,
-    /// A break happened since the last [`Plant::take_break_event`].
-    event: bool,
-    /// The watch's limit. [A]
-    watch_limit_a: Option<f64>,
-    /// Largest leg current since the last [`Plant::take_current_watch`]. [A]
-    peak_a: f64,
-    /// Time any leg current spent above the watch's limit since then. [s]
-    time_above_s: f64,
-}
-
-/// What the current watch saw since it was last read.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct CurrentWatch {
-    /// Largest magnitude of any bridge leg's current. [A]
-    pub peak_a: f64,
-    /// Time any leg's current magnitude spent above the watch's limit. [s]
-    pub time_above_s: f64,
-}
 
 impl Plant {
     /// [`Plant::advance`]'s `n` steps of `h` with the faults' parts: the DC link's voltage,
@@ -250,7 +227,7 @@ impl Plant {
     #[inline]
     pub(super) fn line_electrical(
         &self,
-        x: &super::Vector,
+        x: &Vector,
         line: Line,
         v_pole: [f64; 3],
         e: Phasor,

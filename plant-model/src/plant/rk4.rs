@@ -20,10 +20,10 @@
 //! rotated through the stage's angle increment (a Taylor series exact to rounding for the
 //! ≤ 0.1 rad a step turns, libm beyond).
 
-use super::{
-    ix, Aux, Drive, Inputs, Plant, RotorPhasor, Vector, EVENT_REFINEMENTS, EVENT_TOLERANCE,
-    MAX_EVENTS_PER_STEP, ROTOR_RESYNC_STEPS,
-};
+use super::actuator::Plant;
+use super::inputs::{Drive, Inputs};
+use super::integrator::{EVENT_REFINEMENTS, EVENT_TOLERANCE, MAX_EVENTS_PER_STEP};
+use super::state::{ix, Aux, RotorPhasor, Vector, ROTOR_RESYNC_STEPS};
 use crate::friction::{Friction, Slip};
 use crate::motor::Phasor;
 

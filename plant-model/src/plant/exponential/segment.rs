@@ -3,11 +3,49 @@
 //! the hydraulic block solved exactly, the absorber's oil and both gases along their
 //! polytropic laws (the scheme of [`super`]).
 
-use super::super::{ix, Drive, Plant};
+use super::super::actuator::Plant;
+use super::super::inputs::{Drive, Inputs};
+use super::super::state::{ix, AngleTerms, Vector};
 use super::blocks::mv;
+use super::history::{BlockKey, BlockPhi, Poly};
+use super::rates::Rates;
 use super::winding::Shaft;
-use super::{BlockPhi, Poly, Segment, Start};
 use crate::friction::Slip;
+use crate::motor::Phasor;
+
+/// Whether the absorber's poppet lets oil through during a segment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Port {
+    /// Open: port A and the inlet flow are the exact block.
+    Open,
+    /// Shut (or no absorber): the inlet flow is held, port A is explicit.
+    Shut,
+}
+
+/// The state at a segment's end, its shaft-angle terms, and the energies it books besides
+/// friction's and the external work.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Segment {
+    pub(super) x: Vector,
+    pub(super) at: AngleTerms,
+    /// Input energy, copper loss, damping and stop losses, hydraulic losses. [J]
+    pub(super) e_in: f64,
+    pub(super) e_cu: f64,
+    pub(super) visc_loss: f64,
+    pub(super) hyd_loss: f64,
+}
+
+/// What a segment starts from.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Start<'a> {
+    pub(super) x: &'a Vector,
+    pub(super) at: &'a AngleTerms,
+    pub(super) g: &'a Rates,
+    pub(super) inputs: &'a Inputs,
+    pub(super) port: Port,
+    pub(super) key: BlockKey,
+    pub(super) enabled: bool,
+}
 
 impl Plant {
     /// Integrates one segment of `tau` from `start` with the extrapolation `poly`.
@@ -210,6 +248,12 @@ impl Plant {
             );
         seg.x = x;
         seg
+    }
+
+    /// The shaft-angle terms at `theta`, the rotor phasor turned from `at0`'s.
+    #[inline]
+    pub(super) fn angle_after(&self, at0: &AngleTerms, theta: f64) -> AngleTerms {
+        self.angle_terms_of(theta, at0.rot_m * Phasor::small(theta - at0.theta))
     }
 }
 

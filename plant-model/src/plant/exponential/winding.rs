@@ -4,10 +4,12 @@
 //! slowly and where a phase current crosses the edge of the dead time's band (eq. 2, 5, 17–19;
 //! the dead time as in [`crate::inverter`]).
 
-use super::super::{ix, AngleTerms, Plant, Vector, EVENT_REFINEMENTS, EVENT_TOLERANCE};
+use super::super::actuator::Plant;
+use super::super::integrator::{EVENT_REFINEMENTS, EVENT_TOLERANCE};
+use super::super::state::{ix, AngleTerms, Vector};
 use super::blocks::{mv, winding_series, Winding, WindingStart, M2};
+use super::history::Poly;
 use super::rates::Rates;
-use super::Poly;
 use crate::inverter::{dq_to_abc, pole_to_dq};
 use crate::motor::Phasor;
 

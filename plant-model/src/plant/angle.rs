@@ -1,0 +1,44 @@
+//! Everything that depends on the shaft angle alone: the rotor phasors, the magnet flux with
+//! its harmonics (eq. 17–19), the cogging torque (eq. 16) and the pump's displacement factor
+//! (eq. 20), one `sincos` per evaluation at most (every harmonic a power of the shaft-angle
+//! phasor), the kept terms reused while the angle is the same.
+
+use super::actuator::Plant;
+use super::state::AngleTerms;
+use crate::motor::Phasor;
+
+impl Plant {
+    /// The shaft-angle terms at `theta`: the kept ones when they belong to it, else computed
+    /// (from the kept rotor phasor when that belongs to it, else with one `sincos`).
+    #[inline]
+    pub(super) fn angle_terms(&self, theta: f64) -> AngleTerms {
+        if theta == self.angle.theta {
+            self.angle
+        } else if theta == self.rotor.theta {
+            self.angle_terms_of(theta, self.rotor.phasor)
+        } else {
+            self.angle_terms_of(theta, Phasor::of(theta))
+        }
+    }
+
+    /// The shaft-angle terms at `theta` near `a0.theta` (an RK4 stage), its phasor by rotating
+    /// `a0`'s through the difference.
+    #[inline]
+    pub(super) fn angle_terms_rotated(&self, a0: &AngleTerms, theta: f64) -> AngleTerms {
+        self.angle_terms_of(theta, a0.rot_m * Phasor::small(theta - a0.theta))
+    }
+
+    /// One sincos per evaluation at most: every harmonic is a power of the shaft-angle phasor.
+    #[inline]
+    pub(super) fn angle_terms_of(&self, theta: f64, rot_m: Phasor) -> AngleTerms {
+        let rot_e = rot_m.pow(self.pole_pairs);
+        AngleTerms {
+            theta,
+            rot_m,
+            rot_e,
+            flux: self.motor.magnet_flux_at(rot_e),
+            t_cog: self.motor.cogging_torque_at(rot_m),
+            factor: self.pump.displacement_factor_at(theta, rot_m),
+        }
+    }
+}
