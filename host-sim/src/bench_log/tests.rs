@@ -1,6 +1,7 @@
 //! The bench-log reader and writer against the contract's rules.
 
 use super::*;
+use std::path::Path;
 
 fn log_text(rows: usize, header: &str, row: impl Fn(usize) -> String) -> String {
     let mut s = String::from("# source: test\n# rig: nominal\n");
