@@ -6,7 +6,7 @@
 //!   as one transaction); [`values`]: the command line's number parsers.
 //! - [`bench_log`]: the bench-log CSV contract (`shared/contracts/bench-log.md`), read and
 //!   written.
-//! - [`rig_file`]: the rig-file format, TOML of [`plant_model::Rig`], and `eha rig`.
+//! - [`rig_file`]: the rig-file format, TOML of [`plant_model::Rig`]; [`rig_command`]: `eha rig`.
 //! - [`study`]: the paper's accumulator study (Section 4.3 design, Section 5.2 sweep).
 //! - [`simulate`]: `eha simulate` and `eha demo`; [`run`]: one closed-loop run as a bench
 //!   log.
@@ -29,6 +29,7 @@ pub mod ingest;
 pub mod output;
 pub mod plots;
 pub mod pulsation;
+pub mod rig_command;
 pub mod rig_file;
 pub mod run;
 pub mod simulate;

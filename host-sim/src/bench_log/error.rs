@@ -126,7 +126,7 @@ pub enum Problem {
 #[derive(Debug, thiserror::Error)]
 pub enum BenchLogError {
     /// The file cannot be opened or read.
-    #[error("bench log `{}`: {}", file.display(), crate::output::paths::describe(source))]
+    #[error("bench log `{}`: {}", file.display(), crate::output::file_kind::describe(source))]
     Read {
         /// The file.
         file: PathBuf,

@@ -19,7 +19,7 @@ pub fn read(path: &Path) -> Result<BenchLog, BenchLogError> {
         file: path.to_path_buf(),
         source,
     };
-    if let Some(why) = crate::output::paths::input_problem(path) {
+    if let Some(why) = crate::output::file_kind::input_problem(path) {
         return Err(io_err(io::Error::new(io::ErrorKind::InvalidInput, why)));
     }
     let file = File::open(path).map_err(io_err)?;
@@ -234,7 +234,7 @@ pub fn read_metadata(path: &Path) -> Result<Vec<(String, String)>, BenchLogError
         file: path.to_path_buf(),
         source,
     };
-    if let Some(why) = crate::output::paths::input_problem(path) {
+    if let Some(why) = crate::output::file_kind::input_problem(path) {
         return Err(io_err(io::Error::new(io::ErrorKind::InvalidInput, why)));
     }
     let file = File::open(path).map_err(io_err)?;

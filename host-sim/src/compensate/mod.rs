@@ -209,7 +209,7 @@ pub fn read_table(path: &std::path::Path, rig: &Rig) -> Result<Feedforward, CliE
     let bad =
         |why: String| CliError::BadInput(format!("compensation table `{}`: {why}", path.display()));
     let len = std::fs::metadata(path)
-        .map_err(|e| bad(crate::output::paths::describe(&e)))?
+        .map_err(|e| bad(crate::output::file_kind::describe(&e)))?
         .len();
     if !(RECORD_LEN as u64..=MAX_FILE_LEN).contains(&len) {
         return Err(bad(record::RecordError::Length {
@@ -217,7 +217,7 @@ pub fn read_table(path: &std::path::Path, rig: &Rig) -> Result<Feedforward, CliE
         }
         .to_string()));
     }
-    let bytes = std::fs::read(path).map_err(|e| bad(crate::output::paths::describe(&e)))?;
+    let bytes = std::fs::read(path).map_err(|e| bad(crate::output::file_kind::describe(&e)))?;
     let (rec, trailer) = bytes.split_at(RECORD_LEN.min(bytes.len()));
     let mut table = Table::ZERO;
     record::from_bytes(rec, &mut table).map_err(|e| bad(e.to_string()))?;
