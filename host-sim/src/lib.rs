@@ -13,6 +13,8 @@
 //! - [`ingest`]: the firmware's defmt telemetry (decoded text) to a bench log.
 //! - [`commission`], [`tune`]: commissioning on the simulated motor and loop tuning from a
 //!   step log; [`can_commands`]: parameter changes as `cansend` lines and `candump` logs.
+//! - [`compensate`]: the torque feed-forward learned from bench logs; [`feedforward`]: what
+//!   it loads into a drive, and the table file that carries it.
 //! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain; [`fleet`]:
 //!   many logs diagnosed at once, one table, each drive's trends; [`timestamp`]: the RFC
 //!   3339 times of logs and predictions.
@@ -24,6 +26,7 @@ pub mod cli;
 pub mod commission;
 pub mod compensate;
 pub mod diagnose;
+pub mod feedforward;
 pub mod fleet;
 pub mod ingest;
 pub mod output;
