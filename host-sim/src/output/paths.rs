@@ -12,7 +12,8 @@
 //! folder is refused, since reading it would never end or means nothing.
 
 use super::error::CliError;
-use super::file_kind::{describe, input_problem, kind, same_file};
+pub use super::file_kind::{describe, input_problem};
+use super::file_kind::{kind, same_file};
 use super::stdout::is_stdout;
 use std::fs::{self, OpenOptions};
 use std::io;
