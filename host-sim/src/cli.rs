@@ -12,9 +12,11 @@ use crate::compensate::CompensateArgs;
 use crate::diagnose::command::DiagnoseArgs;
 use crate::fleet::FleetArgs;
 use crate::ingest::IngestArgs;
+use crate::output::file_kind::describe;
 use crate::output::paths::{self, Declared};
 use crate::output::{interrupt, CliError};
-use crate::rig_file::{self, RigArgs};
+use crate::rig_command::{self, RigArgs};
+use crate::rig_file;
 use crate::simulate::demo::DemoArgs;
 use crate::simulate::SimulateArgs;
 use crate::study::precharge_sweep::SweepPrechargeArgs;
@@ -88,7 +90,7 @@ pub fn main() -> ExitCode {
                     let _ = writeln!(
                         io::stderr(),
                         "eha: error: cannot write standard output: {}",
-                        paths::describe(&why)
+                        describe(&why)
                     );
                     return ExitCode::FAILURE;
                 }
@@ -136,7 +138,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         None => Rig::nominal(),
     };
     match &cli.command {
-        Command::Rig(a) => rig_file::run_rig(&rig, a),
+        Command::Rig(a) => rig_command::run_rig(&rig, a),
         Command::AccumulatorDesign(a) => crate::study::run_accumulator_design(&rig, a),
         Command::Demo(a) => crate::simulate::demo::run_demo(&rig, a),
         Command::Simulate(a) => crate::simulate::run_simulate(&rig, a),

@@ -6,13 +6,15 @@
 //!   as one transaction); [`values`]: the command line's number parsers.
 //! - [`bench_log`]: the bench-log CSV contract (`shared/contracts/bench-log.md`), read and
 //!   written.
-//! - [`rig_file`]: the rig-file format, TOML of [`plant_model::Rig`], and `eha rig`.
+//! - [`rig_file`]: the rig-file format, TOML of [`plant_model::Rig`]; [`rig_command`]: `eha rig`.
 //! - [`study`]: the paper's accumulator study (Section 4.3 design, Section 5.2 sweep).
 //! - [`simulate`]: `eha simulate` and `eha demo`; [`run`]: one closed-loop run as a bench
 //!   log.
 //! - [`ingest`]: the firmware's defmt telemetry (decoded text) to a bench log.
 //! - [`commission`], [`tune`]: commissioning on the simulated motor and loop tuning from a
 //!   step log; [`can_commands`]: parameter changes as `cansend` lines and `candump` logs.
+//! - [`compensate`]: the torque feed-forward learned from bench logs; [`feedforward`]: what
+//!   it loads into a drive, and the table file that carries it.
 //! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain; [`fleet`]:
 //!   many logs diagnosed at once, one table, each drive's trends; [`timestamp`]: the RFC
 //!   3339 times of logs and predictions.
@@ -24,11 +26,13 @@ pub mod cli;
 pub mod commission;
 pub mod compensate;
 pub mod diagnose;
+pub mod feedforward;
 pub mod fleet;
 pub mod ingest;
 pub mod output;
 pub mod plots;
 pub mod pulsation;
+pub mod rig_command;
 pub mod rig_file;
 pub mod run;
 pub mod simulate;

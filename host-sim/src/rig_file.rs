@@ -8,48 +8,18 @@
 //! misspelt key would otherwise be ignored silently), then the physics ([`Rig::validate`],
 //! naming the parameter). A file must give every parameter: start from `eha rig > my.toml`.
 //!
-//! `eha rig` ([`run_rig`]) prints a rig in this format.
+//! `eha rig` ([`crate::rig_command`]) prints a rig in this format.
 
-use crate::output::{is_stdout, CliError, Outputs};
-use clap::Args;
+use crate::output::file_kind::{describe, input_problem};
 use plant_model::{Rig, RigError};
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
-
-/// `eha rig`.
-#[derive(Debug, Args)]
-pub struct RigArgs {
-    /// Also write the rig as JSON (`-`: standard output, instead of the TOML).
-    #[arg(long, value_name = "PATH")]
-    pub json: Option<PathBuf>,
-}
-
-impl RigArgs {
-    /// The files it writes.
-    pub fn paths(&self) -> crate::output::paths::Declared<'_> {
-        crate::output::paths::Declared::default().file("--json", self.json.as_ref())
-    }
-}
-
-/// `eha rig`: the TOML on standard output; with `--json PATH` the JSON too (with `--json -`
-/// only the JSON, so standard output stays one parseable document).
-pub fn run_rig(rig: &Rig, a: &RigArgs) -> Result<(), CliError> {
-    let mut out = Outputs::new();
-    if let Some(path) = &a.json {
-        let value = serde_json::to_value(rig).map_err(|e| CliError::Failed(e.to_string()))?;
-        out.json("--json", path, &value)?;
-    }
-    if !a.json.as_deref().is_some_and(is_stdout) {
-        out.print(&to_toml(rig));
-    }
-    out.commit()
-}
 
 /// A rig file that cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum RigFileError {
     /// The file cannot be read.
-    #[error("rig file `{}`: {}", file.display(), crate::output::paths::describe(source))]
+    #[error("rig file `{}`: {}", file.display(), describe(source))]
     Read {
         /// The file.
         file: PathBuf,
@@ -100,7 +70,7 @@ pub fn load(path: &Path) -> Result<Rig, RigFileError> {
         source,
     };
     let refuse = |why: String| read_err(std::io::Error::new(std::io::ErrorKind::InvalidInput, why));
-    if let Some(why) = crate::output::paths::input_problem(path) {
+    if let Some(why) = input_problem(path) {
         return Err(refuse(why));
     }
     let mut bytes = Vec::new();

@@ -11,7 +11,7 @@
 
 use crate::bench_log::limits::{max_rows, physical_range};
 use crate::bench_log::BenchLog;
-use crate::compensate::Feedforward;
+use crate::feedforward::Feedforward;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
 use firmware::config::Config;
 use firmware::parameters::ParamId;
@@ -60,6 +60,10 @@ pub struct RunOptions {
     /// The plant's integration scheme (the exponential one by default).
     pub integrator: Integrator,
 }
+
+/// Log rate of the bench logs `eha` simulates (`eha simulate`, `eha demo`, the holding
+/// runs `eha compensate` and the precharge sweep predict with). [Hz]
+pub const LOG_RATE_HZ: f64 = 2000.0;
 
 /// The bench-log columns a run logs: the six required, the shaft angle, piston position,
 /// low-side pressure, speed and current references and the three voltages.

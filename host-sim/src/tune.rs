@@ -8,7 +8,8 @@
 //! - [`candidates`], [`predict`]: the closed-loop replays (the firmware's control core
 //!   against the plant model) the proposal is chosen and predicted with;
 //! - [`can`]: the `SetParameter` frames;
-//! - [`report`]: the JSON document and the text printed.
+//! - [`report`]: the JSON document and the text printed;
+//! - [`tuning`]: what tuning a loop gives; [`gains`]: a PI's two gains.
 //!
 //! The *current* gains are those of the controller configured from the rig (`--rig`, the
 //! rig the engineer believes in): for the pressure loop, its schedule's gains at the step's
@@ -17,19 +18,21 @@
 pub mod can;
 pub mod candidates;
 pub mod fit;
+pub mod gains;
 pub mod glitch;
 pub mod predict;
 pub mod pressure;
 pub mod report;
 pub mod speed;
 pub mod step;
+pub mod tuning;
 
 use crate::bench_log::BenchLog;
 use crate::output::paths::Declared;
 use crate::output::{is_stdout, CliError, Outputs};
 use crate::values::{non_negative_f64, positive_f64, show};
 use can::Setting;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use closed_loop::controller_config;
 use firmware::config::Config;
 use firmware::parameters::ParamId;
@@ -38,14 +41,8 @@ use predict::StepSpec;
 use std::path::PathBuf;
 use step::{Signal, Step, StepError, StepMetrics, Target};
 
-/// Which loop `eha tune` identifies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum LoopKind {
-    /// Speed loop (speed reference step).
-    Speed,
-    /// Pressure loop (pressure setpoint step).
-    Pressure,
-}
+pub use gains::Gains;
+pub use tuning::{Identified, LoopKind, Tuning};
 
 /// `eha tune`.
 #[derive(Debug, Args)]
@@ -95,79 +92,6 @@ pub const PRESSURE_TARGET: Target = Target {
     overshoot_percent: 15.0,
     settling_s: 0.8,
 };
-
-/// Proportional and integral gain of a PI. Speed: [A/(rad/s)], [A/rad]; pressure:
-/// [(rad/s)/Pa], [(rad/s)/(Pa·s)].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Gains {
-    /// Proportional gain.
-    pub kp: f64,
-    /// Integral gain.
-    pub ki: f64,
-}
-
-/// What was identified, per loop.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Identified {
-    /// The shaft, and what the rig assumed.
-    Speed {
-        /// Identified.
-        shaft: speed::Shaft,
-        /// The rig's inertia. [kg·m²]
-        assumed_inertia_kg_m2: f64,
-        /// The rig's viscous friction. [N·m·s]
-        assumed_viscous_nm_s: f64,
-    },
-    /// The high-pressure side, and what the controller's schedule assumed.
-    Pressure {
-        /// Identified.
-        high: pressure::HighSide,
-        /// The schedule's precharge. [Pa]
-        assumed_precharge_pa: f64,
-        /// The schedule's oil capacitance `V_oil/β`. [m³/Pa]
-        assumed_oil_capacitance_m3_per_pa: f64,
-        /// Identified capacitance at the step's final setpoint. [m³/Pa]
-        capacitance_m3_per_pa: f64,
-        /// The schedule's capacitance there. [m³/Pa]
-        assumed_capacitance_m3_per_pa: f64,
-    },
-}
-
-/// The result of tuning one loop from one log.
-#[derive(Clone, Debug)]
-pub struct Tuning {
-    /// The loop.
-    pub loop_kind: LoopKind,
-    /// The step found in the log.
-    pub step: Step,
-    /// When the step's reference left its initial value in the log. [s]
-    pub step_time_s: f64,
-    /// Its replay (setpoints and windows) used for the predictions.
-    pub spec: StepSpec,
-    /// The target.
-    pub target: Target,
-    /// The identified plant.
-    pub identified: Identified,
-    /// The controller's configuration from the rig.
-    pub current_config: Config,
-    /// Its gains (the schedule's at the final setpoint for pressure).
-    pub current_gains: Gains,
-    /// The proposed configuration.
-    pub proposed_config: Config,
-    /// Its gains.
-    pub proposed_gains: Gains,
-    /// The parameters to send.
-    pub settings: Vec<Setting>,
-    /// The logged step's overshoot and settling.
-    pub measured: StepMetrics,
-    /// The proposal's, replayed on the identified plant.
-    pub predicted: StepMetrics,
-    /// The current gains replayed on the identified plant: how well the model reproduces
-    /// the log.
-    pub replayed_current: StepMetrics,
-    /// Remarks for the engineer.
-    pub notes: Vec<String>,
-}
 
 /// Why a log cannot be tuned from.
 #[derive(Debug, thiserror::Error)]

@@ -6,7 +6,7 @@
 //! shortest interval between two rows a sampler makes ([`MIN_SAMPLE_INTERVAL_S`]), and
 //! excerpts of offending fields instead of the fields whole ([`excerpt`]).
 
-use super::Signal;
+use super::columns::Signal;
 use std::io::{self, Read};
 
 /// The longest line a bench log may have: a row of every column in full precision is under

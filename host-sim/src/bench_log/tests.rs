@@ -1,6 +1,7 @@
 //! The bench-log reader and writer against the contract's rules.
 
 use super::*;
+use std::path::Path;
 
 fn log_text(rows: usize, header: &str, row: impl Fn(usize) -> String) -> String {
     let mut s = String::from("# source: test\n# rig: nominal\n");
@@ -280,7 +281,7 @@ fn drive_and_recorded_at_are_kept_and_read_alone_from_the_head() {
     let bytes = to_bytes(&log).unwrap();
     assert!(String::from_utf8_lossy(&bytes).starts_with("# drive: press-07\n"));
     // The head alone: the metadata without reading the rows (which here are broken).
-    let dir = crate::output::scratch_dir("bench-log-meta");
+    let dir = crate::output::scratch::scratch_dir("bench-log-meta");
     let path = dir.join("head.csv");
     let head = "# drive: press-07\n# recorded_at: 2026-11-30T14:05:00Z\nt_s,oops\nnot,a,row\n";
     std::fs::write(&path, head).unwrap();

@@ -1,10 +1,10 @@
 //! The CAN frames that load a table into a drive, built with the firmware's own encoder
 //! (`firmware::can_protocol`): the header, the bins in order, the commit with the record's
-//! CRC, the speed modulation's parameters if there are any ([`super::flow`]), then
+//! CRC, the speed modulation's parameters if there are any ([`crate::feedforward::flow`]), then
 //! `compensation.enabled = 1`; `SaveParameters` (in Disabled) keeps it over a
 //! power cycle. Printed in `cansend` notation.
 
-use super::Feedforward;
+use crate::feedforward::Feedforward;
 use firmware::can_protocol::{encode_command, encode_set_parameter, Frame, NodeId, Request};
 use firmware::compensation::{record, BINS};
 use firmware::parameters::ParamId;
@@ -71,7 +71,7 @@ mod tests {
         raw[10] = [1000, -20, 300];
         let t = Table::from_raw([16, 40, 18], &raw).unwrap();
         let node = NodeId::new(1).unwrap();
-        let flow = super::super::flow::FlowParams {
+        let flow = crate::feedforward::flow::FlowParams {
             pistons: 9,
             ratio: 0.0152,
             phase_rad: 0.0,

@@ -215,6 +215,28 @@ pub fn mean_low_pressure(logs: &[BenchLog], rig: &Rig) -> f64 {
     }
 }
 
+/// What the diagnosis found in a set of logs.
+pub struct Found {
+    /// The significant angle-locked effects, combined over the logs, strongest first.
+    pub effects: Vec<Learned>,
+    /// The low port's mean pressure over the logs. [Pa]
+    pub p_low_pa: f64,
+}
+
+/// Runs the diagnosis on each log (in parallel) and combines what it found.
+pub fn find(logs: &[BenchLog], rig: &Rig) -> Result<Found, CliError> {
+    use rayon::prelude::*;
+    let per_log = logs
+        .par_iter()
+        .map(|log| causes_of(log, rig))
+        .collect::<Result<Vec<_>, _>>()?;
+    let diagnoses: Vec<_> = per_log.into_iter().flatten().collect();
+    Ok(Found {
+        effects: combine(&diagnoses),
+        p_low_pa: mean_low_pressure(logs, rig),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,10 +12,9 @@
 //! answering the transducer's noise (with the absorber fitted, most of what is left), and
 //! for the pressure the pump's kinematic flow ripple, which no torque cancels.
 
-use super::Feedforward;
+use crate::feedforward::Feedforward;
 use crate::output::CliError;
-use crate::run::{run, Run, RunOptions};
-use crate::simulate::LOG_RATE_HZ;
+use crate::run::{run, Run, RunOptions, LOG_RATE_HZ};
 use closed_loop::{by_name, Scenario};
 use plant_model::Rig;
 use rayon::prelude::*;

@@ -10,10 +10,13 @@
 //! Every run is the firmware's control core against the plant through `closed_loop`. The
 //! learning logs use other noise seeds than the evaluation.
 
-use super::flow::FlowParams;
+use super::learn::find;
+use super::method::{feedforward_of, Method};
 use super::predict::{self, Pulsation};
-use super::{feedforward_of, find, model, table, Feedforward, Method};
+use super::{model, table};
 use crate::bench_log::BenchLog;
+use crate::feedforward::flow::{self, FlowParams};
+use crate::feedforward::Feedforward;
 use crate::output::CliError;
 use crate::run::{run, RunOptions};
 use closed_loop::scenario::HOLD_PRESSURE_PA;
@@ -193,7 +196,7 @@ pub fn learn_tables(rig: &Rig, plant: &Rig) -> Result<Tables, CliError> {
             &bench,
             rig,
             Method::Model,
-            &[super::flow::EXCLUDE_NAME.to_string()],
+            &[flow::EXCLUDE_NAME.to_string()],
         )?,
         model_without_pump: feedforward_of(
             &found,

@@ -3,9 +3,11 @@
 //! without and with the feed-forward, the CAN frames that load it — and the JSON of the
 //! `eha` CLI contract.
 
+use super::args::CompensateArgs;
+use super::can;
 use super::learn::Learned;
+use super::outcome::Outcome;
 use super::predict::reduction_percent;
-use super::{can, CompensateArgs, Outcome};
 use firmware::can_protocol::{Frame, NodeId};
 use firmware::compensation::record;
 use firmware::compensation::{Channel, BINS};

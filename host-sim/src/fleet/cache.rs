@@ -130,7 +130,7 @@ mod tests {
     #[test]
     fn hashes_are_sha256_of_the_bytes() {
         // FIPS 180-2's test vector "abc", and the empty message.
-        let d = crate::output::scratch_dir("fleet-sha");
+        let d = crate::output::scratch::scratch_dir("fleet-sha");
         std::fs::write(d.join("abc"), b"abc").unwrap();
         std::fs::write(d.join("empty"), b"").unwrap();
         assert_eq!(
@@ -146,7 +146,7 @@ mod tests {
 
     #[test]
     fn records_hold_only_for_their_rig_and_version() {
-        let d = crate::output::scratch_dir("fleet-cache");
+        let d = crate::output::scratch::scratch_dir("fleet-cache");
         let ctx = Context {
             rig_sha256: NOMINAL_RIG.into(),
             eha_version: "1.0".into(),

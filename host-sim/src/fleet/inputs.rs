@@ -9,7 +9,7 @@
 //! concatenated in order, are the whole table.
 
 use crate::bench_log::{self, DRIVE_KEY, RECORDED_AT_KEY};
-use crate::output::paths::describe;
+use crate::output::file_kind::describe;
 use crate::output::CliError;
 use crate::timestamp::parse_days;
 use std::collections::BTreeMap;
@@ -306,7 +306,7 @@ mod tests {
 
     #[test]
     fn the_manifest_wins_and_folders_are_searched_without_the_output() {
-        let d = crate::output::scratch_dir("fleet-inputs");
+        let d = crate::output::scratch::scratch_dir("fleet-inputs");
         let logs = d.join("logs");
         std::fs::create_dir_all(logs.join("b")).unwrap();
         std::fs::create_dir_all(logs.join(".hidden")).unwrap();

@@ -111,7 +111,11 @@ fn rig_identity(rig_file: Option<&Path>) -> Result<String, CliError> {
     match rig_file {
         None => Ok(cache::NOMINAL_RIG.into()),
         Some(p) => cache::sha256_file(p).map_err(|e| {
-            CliError::BadInput(format!("--rig `{}`: {}", p.display(), paths::describe(&e)))
+            CliError::BadInput(format!(
+                "--rig `{}`: {}",
+                p.display(),
+                crate::output::file_kind::describe(&e)
+            ))
         }),
     }
 }
@@ -125,7 +129,7 @@ fn hash_all(entries: &[Entry], jobs: usize) -> Vec<Result<String, String>> {
             format!(
                 "bench log `{}`: {}",
                 e.path.display(),
-                paths::describe(&err)
+                crate::output::file_kind::describe(&err)
             )
         }),
     };

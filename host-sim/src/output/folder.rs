@@ -7,7 +7,7 @@
 //! file, a folder, another file, or an input of the command in it is refused, named,
 //! before any work.
 
-use super::paths::{describe, kind, same_file};
+use super::file_kind::{describe, kind, same_file};
 use std::fs;
 use std::path::Path;
 
@@ -96,7 +96,7 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn links_special_files_and_foreign_files_are_named() {
-        let d = crate::output::scratch_dir("folder-problem");
+        let d = crate::output::scratch::scratch_dir("folder-problem");
         let owned = ["report.md", "*.svg"];
         assert_eq!(problem(&d, &owned, &[]), None);
         fs::write(d.join("report.md"), "old").unwrap();

@@ -11,55 +11,13 @@
 //! pipes (`<(command)`, `/dev/stdin` on a pipe); a device (`/dev/zero`), a socket or a
 //! folder is refused, since reading it would never end or means nothing.
 
-use super::{is_stdout, CliError};
-use std::fs::{self, Metadata, OpenOptions};
+use super::error::CliError;
+pub use super::file_kind::{describe, input_problem};
+use super::file_kind::{kind, same_file};
+use super::stdout::is_stdout;
+use std::fs::{self, OpenOptions};
 use std::io;
 use std::path::{Component, Path, PathBuf};
-
-/// What kind of file system object a path is, in words.
-pub(super) fn kind(m: &Metadata) -> &'static str {
-    let t = m.file_type();
-    if t.is_dir() {
-        return "a folder";
-    }
-    if t.is_symlink() {
-        return "a symbolic link";
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a FIFO (named pipe)";
-        }
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_file() {
-        "a regular file"
-    } else {
-        "a special file"
-    }
-}
-
-fn is_fifo(m: &Metadata) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        m.file_type().is_fifo()
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = m;
-        false
-    }
-}
 
 pub(super) fn bad(flag: &str, path: &Path, why: impl std::fmt::Display) -> CliError {
     let name = if flag.is_empty() {
@@ -154,15 +112,6 @@ pub fn input_file(flag: &str, path: &Path) -> Result<(), CliError> {
         return Err(CliError::BadInput(format!("{flag}: the path is empty")));
     }
     input_problem(path).map_or(Ok(()), |why| Err(bad(flag, path, why)))
-}
-
-/// What makes `path` no readable input file, if anything.
-pub fn input_problem(path: &Path) -> Option<String> {
-    match fs::metadata(path) {
-        Err(e) => Some(describe(&e)),
-        Ok(m) if m.is_file() || is_fifo(&m) => None,
-        Ok(m) => Some(format!("is {}, not a file eha can read", kind(&m))),
-    }
 }
 
 /// The file an output path will replace: the path itself, or for a symbolic link the
@@ -384,25 +333,6 @@ fn writable_folder(flag: &str, path: &Path, folder: &Path) -> Result<(), CliErro
     }
 }
 
-/// Whether two existing paths are the same file (hard links and symbolic links included).
-pub(super) fn same_file(a: &Path, b: &Path) -> bool {
-    match (fs::metadata(a), fs::metadata(b)) {
-        (Ok(ma), Ok(mb)) => {
-            #[cfg(unix)]
-            {
-                use std::os::unix::fs::MetadataExt;
-                ma.dev() == mb.dev() && ma.ino() == mb.ino()
-            }
-            #[cfg(not(unix))]
-            {
-                let _ = (ma, mb);
-                fs::canonicalize(a).ok() == fs::canonicalize(b).ok()
-            }
-        }
-        _ => false,
-    }
-}
-
 /// Whether two output paths, existing or not, name one destination.
 fn same_destination(a: &Path, b: &Path) -> bool {
     if same_file(a, b) {
@@ -418,31 +348,12 @@ fn same_destination(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// An I/O error in words, without Rust's `(os error N)` suffix; eha's own reasons (carried
-/// as `InvalidInput`) as written.
-pub fn describe(e: &io::Error) -> String {
-    match e.kind() {
-        io::ErrorKind::NotFound => "does not exist".into(),
-        io::ErrorKind::PermissionDenied => "permission denied".into(),
-        io::ErrorKind::NotADirectory => "a part of the path is not a folder".into(),
-        io::ErrorKind::InvalidInput => e.to_string(),
-        _ => {
-            let s = e.to_string();
-            let s = s.find(" (os error").map_or(s.as_str(), |i| &s[..i]);
-            let mut c = s.chars();
-            c.next()
-                .map(|f| f.to_lowercase().chain(c).collect())
-                .unwrap_or_default()
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn scratch(name: &str) -> PathBuf {
-        crate::output::scratch_dir(&format!("paths-{name}"))
+        crate::output::scratch::scratch_dir(&format!("paths-{name}"))
     }
 
     #[test]

@@ -18,11 +18,13 @@
 //! link inside it is written through; what it may hold before is checked
 //! ([`super::folder`]).
 
+use super::error::CliError;
+use super::file_kind::describe;
 use super::folder;
 use super::hooks;
 use super::interrupt::{self, Guard};
-use super::paths::{self, describe};
-use super::{is_stdout, print_stdout, CliError};
+use super::paths;
+use super::stdout::{is_stdout, print_stdout};
 use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};

@@ -4,14 +4,14 @@
 //! SVG plots in an output folder.
 
 use super::holding::pulsation;
-use super::{converged, effects_text, plant_rig, rig_name, LOG_RATE_HZ};
+use super::{converged, effects_text, plant_rig, rig_name};
 use crate::bench_log::write_into;
-use crate::compensate::Feedforward;
+use crate::feedforward::Feedforward;
 use crate::output::paths::Declared;
 use crate::output::{CliError, Outputs, StagedFolder};
 use crate::plots::{line_chart, stacked_chart, Figure, Marker, Panel, Series};
 use crate::pulsation::sources;
-use crate::run::{run, Run, RunOptions};
+use crate::run::{run, Run, RunOptions, LOG_RATE_HZ};
 use clap::Args;
 use closed_loop::{by_name, Scenario};
 use plant_model::effects::paper_low_speed_effects;

@@ -5,10 +5,9 @@
 //! measured pressure adds the transducer's noise and 477 Pa quantisation, which would
 //! dominate the peak-to-peak at these amplitudes; both are in the bench log).
 
-use super::LOG_RATE_HZ;
 use crate::output::CliError;
 use crate::pulsation::{amplitude_spectrum, dominant_line, peak_to_peak, sources, Source};
-use crate::run::{run, Run, RunOptions};
+use crate::run::{run, Run, RunOptions, LOG_RATE_HZ};
 use closed_loop::{by_name, Scenario};
 use plant_model::Rig;
 

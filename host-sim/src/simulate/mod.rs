@@ -19,8 +19,7 @@ use serde_json::json;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Log rate of the simulated bench logs. [Hz]
-pub const LOG_RATE_HZ: f64 = 2000.0;
+pub use crate::run::LOG_RATE_HZ;
 
 /// `eha simulate`.
 #[derive(Debug, Args)]
@@ -327,7 +326,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     };
     let plant = plant_rig(&base, &effects)?;
     let compensation = match &args.compensation {
-        Some(path) => Some(crate::compensate::read_table(path, &controller)?),
+        Some(path) => Some(crate::feedforward::read_table(path, &controller)?),
         None => None,
     };
     let duration = args.duration.unwrap_or(scenario.duration_s);

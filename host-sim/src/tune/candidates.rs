@@ -4,9 +4,9 @@
 //! target nearest to the firmware's documented design is kept — the design is changed no
 //! more than the plant requires.
 
+use super::gains::Gains;
 use super::predict::{self, StepSpec};
 use super::step::{StepMetrics, Target};
-use super::Gains;
 use firmware::config::Config;
 use plant_model::Rig;
 use rayon::prelude::*;

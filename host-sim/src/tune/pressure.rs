@@ -34,9 +34,9 @@
 
 use super::candidates::{self, Candidate, Design};
 use super::fit::{least_squares, Fit};
+use super::gains::Gains;
 use super::predict::StepSpec;
 use super::step::{centred_mean, Signal, Step, Target};
-use super::Gains;
 use crate::bench_log::BenchLog;
 use argmin::core::{CostFunction, Executor};
 use argmin::solver::brent::BrentOpt;

@@ -1,8 +1,9 @@
 //! What `eha tune` reports: the `--json` document (`contracts/eha-cli.md`) and the text on
 //! standard output, both with the CAN commands that apply the proposal.
 
+use super::can;
 use super::step::{StepMetrics, Target};
-use super::{can, Identified, LoopKind, Tuning};
+use super::tuning::{Identified, LoopKind, Tuning};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 

@@ -33,9 +33,9 @@
 
 use super::candidates::{self, Candidate, Design};
 use super::fit::least_squares;
+use super::gains::Gains;
 use super::predict::StepSpec;
 use super::step::{Step, Target};
-use super::Gains;
 use crate::bench_log::BenchLog;
 use firmware::config::Config;
 use plant_model::Rig;

@@ -203,7 +203,7 @@ mod tests {
 
     #[test]
     fn the_finished_log_reads_back_and_too_few_rows_leave_nothing() {
-        let d = crate::output::scratch_dir("live-log");
+        let d = crate::output::scratch::scratch_dir("live-log");
         let path = d.join("run.csv");
         let mut log = LiveLog::create(&path).unwrap();
         for i in 0..150 {

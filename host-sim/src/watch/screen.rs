@@ -5,8 +5,8 @@
 //! fast for the screen still shows its band). Keys are read from the terminal itself, so
 //! the stream can come on standard input.
 
+use super::running::{Stream, Watch};
 use super::session::{Pulsation, Session};
-use super::{Stream, Watch};
 use crate::output::{interrupt, CliError};
 use firmware::TelemetryFrame;
 use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};

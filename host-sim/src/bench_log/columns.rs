@@ -1,0 +1,252 @@
+//! The contract's columns and metadata (`bench-log.md`, "File" and "Columns"): the
+//! [`Signal`] of each column name with its unit and whether it is required, the metadata
+//! keys `eha` reads ([`DRIVE_KEY`], [`RECORDED_AT_KEY`]), the fewest rows a log holds
+//! ([`MIN_ROWS`]), and [`BenchLog`], a log in memory: its metadata and one vector per
+//! column.
+
+/// The fewest data rows a bench log may have.
+pub const MIN_ROWS: usize = 100;
+
+/// Metadata key naming the actuator a log comes from (`# drive: ID`).
+pub const DRIVE_KEY: &str = "drive";
+
+/// Metadata key of the time a log started (`# recorded_at: 2026-11-30T14:05:00Z`, RFC 3339).
+pub const RECORDED_AT_KEY: &str = "recorded_at";
+
+/// A column of the contract.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Signal {
+    /// `t_s`: time since the start of the log, strictly increasing. [s]
+    Time,
+    /// `p_ref_pa`: pressure setpoint seen by the controller. [Pa]
+    PressureRef,
+    /// `p_pa`: measured pressure on the pump's high-pressure port. [Pa]
+    Pressure,
+    /// `speed_rad_s`: measured shaft speed. [rad/s]
+    Speed,
+    /// `iq_a`: measured q-axis current. [A]
+    Iq,
+    /// `id_a`: measured d-axis current. [A]
+    Id,
+    /// `theta_m_rad`: shaft mechanical angle. [rad]
+    ThetaM,
+    /// `x_m`: piston position from mid-stroke. [m]
+    PistonPosition,
+    /// `p_low_pa`: pressure on the pump's low-pressure port. [Pa]
+    PressureLow,
+    /// `speed_ref_rad_s`: speed reference. [rad/s]
+    SpeedRef,
+    /// `iq_ref_a`: q-current reference. [A]
+    IqRef,
+    /// `ud_v`: commanded d-axis voltage. [V]
+    Ud,
+    /// `uq_v`: commanded q-axis voltage. [V]
+    Uq,
+    /// `udc_v`: measured DC-link voltage. [V]
+    Udc,
+    /// `oil_temp_c`: oil temperature. [°C]
+    OilTemp,
+}
+
+impl Signal {
+    /// Every column, required ones first, in the order the writer puts them.
+    pub const ALL: [Signal; 15] = [
+        Signal::Time,
+        Signal::PressureRef,
+        Signal::Pressure,
+        Signal::Speed,
+        Signal::Iq,
+        Signal::Id,
+        Signal::ThetaM,
+        Signal::PistonPosition,
+        Signal::PressureLow,
+        Signal::SpeedRef,
+        Signal::IqRef,
+        Signal::Ud,
+        Signal::Uq,
+        Signal::Udc,
+        Signal::OilTemp,
+    ];
+
+    /// The column name in the file.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Signal::Time => "t_s",
+            Signal::PressureRef => "p_ref_pa",
+            Signal::Pressure => "p_pa",
+            Signal::Speed => "speed_rad_s",
+            Signal::Iq => "iq_a",
+            Signal::Id => "id_a",
+            Signal::ThetaM => "theta_m_rad",
+            Signal::PistonPosition => "x_m",
+            Signal::PressureLow => "p_low_pa",
+            Signal::SpeedRef => "speed_ref_rad_s",
+            Signal::IqRef => "iq_ref_a",
+            Signal::Ud => "ud_v",
+            Signal::Uq => "uq_v",
+            Signal::Udc => "udc_v",
+            Signal::OilTemp => "oil_temp_c",
+        }
+    }
+
+    /// Whether every bench log must have this column.
+    pub const fn is_required(self) -> bool {
+        matches!(
+            self,
+            Signal::Time
+                | Signal::PressureRef
+                | Signal::Pressure
+                | Signal::Speed
+                | Signal::Iq
+                | Signal::Id
+        )
+    }
+
+    /// The signal of a column name, if the contract knows it.
+    pub fn from_name(name: &str) -> Option<Signal> {
+        Signal::ALL.into_iter().find(|s| s.name() == name)
+    }
+}
+
+/// One bench log: metadata and one vector per column, all of the same length.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BenchLog {
+    /// The `# key: value` lines, in file order (unknown keys included).
+    pub metadata: Vec<(String, String)>,
+    /// Time since the start of the log, strictly increasing. [s]
+    pub t_s: Vec<f64>,
+    /// Pressure setpoint seen by the controller. [Pa]
+    pub p_ref_pa: Vec<f64>,
+    /// Measured pressure on the pump's high-pressure port (gauge). [Pa]
+    pub p_pa: Vec<f64>,
+    /// Measured motor (= pump) shaft speed. [rad/s]
+    pub speed_rad_s: Vec<f64>,
+    /// Measured q-axis current (amplitude-invariant Park transform). [A]
+    pub iq_a: Vec<f64>,
+    /// Measured d-axis current. [A]
+    pub id_a: Vec<f64>,
+    /// Shaft mechanical angle, wrapped or unwrapped. [rad]
+    pub theta_m_rad: Option<Vec<f64>>,
+    /// Piston position from mid-stroke; absent means blocked. [m]
+    pub x_m: Option<Vec<f64>>,
+    /// Pressure on the pump's low-pressure port (gauge). [Pa]
+    pub p_low_pa: Option<Vec<f64>>,
+    /// Speed reference. [rad/s]
+    pub speed_ref_rad_s: Option<Vec<f64>>,
+    /// q-current reference. [A]
+    pub iq_ref_a: Option<Vec<f64>>,
+    /// Commanded d-axis voltage. [V]
+    pub ud_v: Option<Vec<f64>>,
+    /// Commanded q-axis voltage. [V]
+    pub uq_v: Option<Vec<f64>>,
+    /// Measured DC-link voltage. [V]
+    pub udc_v: Option<Vec<f64>>,
+    /// Oil temperature. [°C]
+    pub oil_temp_c: Option<Vec<f64>>,
+}
+
+impl BenchLog {
+    /// Number of samples (rows).
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// True when there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// The log from row `from` on (clamped to the last row), its time restarted at zero.
+    pub fn tail(&self, from: usize) -> BenchLog {
+        let k = from.min(self.len().saturating_sub(1));
+        let cut = |v: &Vec<f64>| v.get(k..).map_or_else(Vec::new, <[f64]>::to_vec);
+        let cut_opt = |v: &Option<Vec<f64>>| v.as_ref().map(cut);
+        let t0 = self.t_s.get(k).copied().unwrap_or(0.0);
+        BenchLog {
+            metadata: self.metadata.clone(),
+            t_s: cut(&self.t_s).into_iter().map(|t| t - t0).collect(),
+            p_ref_pa: cut(&self.p_ref_pa),
+            p_pa: cut(&self.p_pa),
+            speed_rad_s: cut(&self.speed_rad_s),
+            iq_a: cut(&self.iq_a),
+            id_a: cut(&self.id_a),
+            theta_m_rad: cut_opt(&self.theta_m_rad),
+            x_m: cut_opt(&self.x_m),
+            p_low_pa: cut_opt(&self.p_low_pa),
+            speed_ref_rad_s: cut_opt(&self.speed_ref_rad_s),
+            iq_ref_a: cut_opt(&self.iq_ref_a),
+            ud_v: cut_opt(&self.ud_v),
+            uq_v: cut_opt(&self.uq_v),
+            udc_v: cut_opt(&self.udc_v),
+            oil_temp_c: cut_opt(&self.oil_temp_c),
+        }
+    }
+
+    /// The value of the first metadata line with `key`.
+    pub fn meta(&self, key: &str) -> Option<&str> {
+        self.metadata
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// The actuator the log comes from (`# drive: ID`), if the log names it.
+    pub fn drive(&self) -> Option<&str> {
+        self.meta(DRIVE_KEY)
+    }
+
+    /// When the log started (`# recorded_at: …`, RFC 3339, as written), if the log says.
+    pub fn recorded_at(&self) -> Option<&str> {
+        self.meta(RECORDED_AT_KEY)
+    }
+
+    /// The column of `signal`, `None` for an absent optional column.
+    pub fn column(&self, signal: Signal) -> Option<&[f64]> {
+        let c = match signal {
+            Signal::Time => &self.t_s,
+            Signal::PressureRef => &self.p_ref_pa,
+            Signal::Pressure => &self.p_pa,
+            Signal::Speed => &self.speed_rad_s,
+            Signal::Iq => &self.iq_a,
+            Signal::Id => &self.id_a,
+            Signal::ThetaM => return self.theta_m_rad.as_deref(),
+            Signal::PistonPosition => return self.x_m.as_deref(),
+            Signal::PressureLow => return self.p_low_pa.as_deref(),
+            Signal::SpeedRef => return self.speed_ref_rad_s.as_deref(),
+            Signal::IqRef => return self.iq_ref_a.as_deref(),
+            Signal::Ud => return self.ud_v.as_deref(),
+            Signal::Uq => return self.uq_v.as_deref(),
+            Signal::Udc => return self.udc_v.as_deref(),
+            Signal::OilTemp => return self.oil_temp_c.as_deref(),
+        };
+        Some(c)
+    }
+
+    /// The column of `signal` for filling, created empty if it was an absent optional one.
+    pub fn column_mut(&mut self, signal: Signal) -> &mut Vec<f64> {
+        match signal {
+            Signal::Time => &mut self.t_s,
+            Signal::PressureRef => &mut self.p_ref_pa,
+            Signal::Pressure => &mut self.p_pa,
+            Signal::Speed => &mut self.speed_rad_s,
+            Signal::Iq => &mut self.iq_a,
+            Signal::Id => &mut self.id_a,
+            Signal::ThetaM => self.theta_m_rad.get_or_insert_with(Vec::new),
+            Signal::PistonPosition => self.x_m.get_or_insert_with(Vec::new),
+            Signal::PressureLow => self.p_low_pa.get_or_insert_with(Vec::new),
+            Signal::SpeedRef => self.speed_ref_rad_s.get_or_insert_with(Vec::new),
+            Signal::IqRef => self.iq_ref_a.get_or_insert_with(Vec::new),
+            Signal::Ud => self.ud_v.get_or_insert_with(Vec::new),
+            Signal::Uq => self.uq_v.get_or_insert_with(Vec::new),
+            Signal::Udc => self.udc_v.get_or_insert_with(Vec::new),
+            Signal::OilTemp => self.oil_temp_c.get_or_insert_with(Vec::new),
+        }
+    }
+
+    /// The columns present, in writing order.
+    pub fn columns(&self) -> impl Iterator<Item = (Signal, &[f64])> {
+        Signal::ALL
+            .into_iter()
+            .filter_map(|s| self.column(s).map(|c| (s, c)))
+    }
+}

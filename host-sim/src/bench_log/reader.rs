@@ -1,0 +1,245 @@
+//! The reader (`bench-log.md`, "File" and "Bad input"): the `# key: value` metadata
+//! lines, the header, whose columns are found by name (unknown ones skipped unread), then
+//! the rows, each value checked as it is read ([`super::rules`]) within the bounds of
+//! [`super::limits`]; the first fault is reported with its file, line and column.
+
+use super::columns::{BenchLog, Signal, MIN_ROWS};
+use super::error::{BenchLogError, Problem};
+use super::limits::{
+    self, excerpt, line_too_long, LineLimited, MAX_METADATA_BYTES, MAX_METADATA_LINES,
+};
+use super::rules::{beyond, metadata_fits, out_of_range, time_problem};
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, Read};
+use std::path::Path;
+
+/// Reads and checks a bench log.
+pub fn read(path: &Path) -> Result<BenchLog, BenchLogError> {
+    let io_err = |source| BenchLogError::Read {
+        file: path.to_path_buf(),
+        source,
+    };
+    if let Some(why) = crate::output::file_kind::input_problem(path) {
+        return Err(io_err(io::Error::new(io::ErrorKind::InvalidInput, why)));
+    }
+    let file = File::open(path).map_err(io_err)?;
+    parse(BufReader::new(file), path)
+}
+
+/// Parses a bench log from `input`; `path` names it in errors.
+pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> {
+    let err = |line: usize, column: &str, problem: Problem| BenchLogError::Content {
+        file: path.to_path_buf(),
+        line,
+        column: excerpt(column),
+        problem,
+    };
+    let io_err = |source| BenchLogError::Read {
+        file: path.to_path_buf(),
+        source,
+    };
+    let mut input = BufReader::new(LineLimited::new(input));
+    let mut log = BenchLog::default();
+    // Metadata and blank lines before the header; the CSV reader takes over at the first
+    // other line, so its line numbers are offset by the lines consumed here.
+    let consumed = parse_metadata(&mut input, path, &mut log.metadata)?;
+
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(input);
+    let mut record = csv::StringRecord::new();
+    let line_of = |r: &csv::StringRecord, fallback: usize| {
+        r.position()
+            .map_or(fallback, |p| consumed + p.line() as usize)
+    };
+    let csv_err = |e: csv::Error, fallback: usize| {
+        let line = e
+            .position()
+            .map_or(fallback, |p| consumed + p.line() as usize);
+        match e.into_kind() {
+            csv::ErrorKind::Io(source) => match line_too_long(&source) {
+                Some(l) => err(l, "", Problem::LineTooLong),
+                None => io_err(source),
+            },
+            csv::ErrorKind::Utf8 { .. } => err(line, "", Problem::NotUtf8),
+            _ => err(line, "", Problem::Malformed("not CSV".into())),
+        }
+    };
+
+    if !reader
+        .read_record(&mut record)
+        .map_err(|e| csv_err(e, consumed + 1))?
+    {
+        return Err(err(consumed + 1, "", Problem::NoHeader));
+    }
+    let header_line = line_of(&record, consumed + 1);
+    let names: Vec<String> = record.iter().map(str::to_string).collect();
+    for (i, n) in names.iter().enumerate() {
+        if let Some(j) = names[..i].iter().position(|m| m == n) {
+            return Err(err(
+                header_line,
+                n,
+                Problem::DuplicateColumn {
+                    first: j + 1,
+                    second: i + 1,
+                },
+            ));
+        }
+    }
+    for s in Signal::ALL.into_iter().filter(|s| s.is_required()) {
+        if !names.iter().any(|n| n == s.name()) {
+            return Err(err(header_line, s.name(), Problem::MissingColumn));
+        }
+    }
+    // (field index, signal) of the columns the contract knows; others are not read.
+    let known: Vec<(usize, Signal)> = names
+        .iter()
+        .enumerate()
+        .filter_map(|(i, n)| Signal::from_name(n).map(|s| (i, s)))
+        .collect();
+    for &(_, s) in &known {
+        log.column_mut(s);
+    }
+    let most_rows = limits::max_rows(known.len());
+
+    let mut last_line = header_line;
+    while reader
+        .read_record(&mut record)
+        .map_err(|e| csv_err(e, last_line + 1))?
+    {
+        let line = line_of(&record, last_line + 1);
+        last_line = line;
+        if log.len() == most_rows {
+            let problem = Problem::TooManyRows { most: most_rows };
+            return Err(err(line, Signal::Time.name(), problem));
+        }
+        if record.len() != names.len() {
+            let column = names
+                .get(record.len().min(names.len().saturating_sub(1)))
+                .filter(|_| record.len() < names.len())
+                .cloned()
+                .unwrap_or_else(|| format!("field {}", names.len() + 1));
+            return Err(err(
+                line,
+                &column,
+                Problem::WrongFieldCount {
+                    expected: names.len(),
+                    found: record.len(),
+                },
+            ));
+        }
+        for &(i, s) in &known {
+            let text = record.get(i).unwrap_or("");
+            let v = match text.parse::<f64>() {
+                Ok(v) if v.is_finite() => v,
+                _ if text.is_empty() => return Err(err(line, s.name(), Problem::EmptyField)),
+                _ => {
+                    return Err(err(
+                        line,
+                        s.name(),
+                        Problem::NotANumber {
+                            text: excerpt(text),
+                        },
+                    ))
+                }
+            };
+            if out_of_range(s, v) {
+                return Err(err(line, s.name(), beyond(s, v)));
+            }
+            if s == Signal::Time {
+                if let Some(problem) = log.t_s.last().and_then(|p| time_problem(*p, v)) {
+                    return Err(err(line, s.name(), problem));
+                }
+            }
+            log.column_mut(s).push(v);
+        }
+    }
+    if log.len() < MIN_ROWS {
+        return Err(err(
+            last_line,
+            Signal::Time.name(),
+            Problem::TooFewRows { rows: log.len() },
+        ));
+    }
+    Ok(log)
+}
+
+/// Reads the `# key: value` lines (and blank lines) before the header of `input` into
+/// `metadata`, leaving `input` at the header; returns the lines consumed.
+fn parse_metadata<R: BufRead>(
+    input: &mut R,
+    path: &Path,
+    metadata: &mut Vec<(String, String)>,
+) -> Result<usize, BenchLogError> {
+    let err = |line: usize, column: &str, problem: Problem| BenchLogError::Content {
+        file: path.to_path_buf(),
+        line,
+        column: excerpt(column),
+        problem,
+    };
+    let io_err = |source| BenchLogError::Read {
+        file: path.to_path_buf(),
+        source,
+    };
+    let mut consumed = 0usize;
+    let mut metadata_bytes = 0usize;
+    let mut line = String::new();
+    loop {
+        let buf = input.fill_buf().map_err(io_err)?;
+        let starts_meta = buf.first() == Some(&b'#')
+            || (consumed == 0 && buf.starts_with("\u{feff}#".as_bytes()));
+        let blank = buf.first() == Some(&b'\n') || buf.starts_with(b"\r\n");
+        if !(starts_meta || blank) {
+            return Ok(consumed);
+        }
+        line.clear();
+        input.read_line(&mut line).map_err(|e| {
+            if let Some(l) = line_too_long(&e) {
+                err(l, "", Problem::LineTooLong)
+            } else if e.kind() == io::ErrorKind::InvalidData {
+                err(consumed + 1, "", Problem::NotUtf8)
+            } else {
+                io_err(e)
+            }
+        })?;
+        consumed += 1;
+        if starts_meta {
+            let text = line.trim_start_matches('\u{feff}').trim_start_matches('#');
+            let (k, v) = text.split_once(':').unwrap_or((text, ""));
+            let (k, v) = (k.trim(), v.trim());
+            if k.is_empty() && v.is_empty() {
+                continue; // a bare `#`: nothing to keep, like a blank line
+            }
+            // What the writer could not write back (an empty key, a carriage return inside
+            // the value) is refused here too, so every log read can be written.
+            if !metadata_fits(k, v) {
+                return Err(err(consumed, k, Problem::BadMetadata));
+            }
+            metadata_bytes += k.len() + v.len();
+            if metadata.len() == MAX_METADATA_LINES || metadata_bytes > MAX_METADATA_BYTES {
+                return Err(err(consumed, k, Problem::TooMuchMetadata));
+            }
+            metadata.push((k.to_string(), v.to_string()));
+        }
+    }
+}
+
+/// Reads only the metadata lines of the bench log at `path` (what `eha fleet` needs to
+/// sort a log before diagnosing it), with the reader's rules for them; the rows are not
+/// read or checked.
+pub fn read_metadata(path: &Path) -> Result<Vec<(String, String)>, BenchLogError> {
+    let io_err = |source| BenchLogError::Read {
+        file: path.to_path_buf(),
+        source,
+    };
+    if let Some(why) = crate::output::file_kind::input_problem(path) {
+        return Err(io_err(io::Error::new(io::ErrorKind::InvalidInput, why)));
+    }
+    let file = File::open(path).map_err(io_err)?;
+    let mut input = BufReader::new(LineLimited::new(file));
+    let mut metadata = Vec::new();
+    parse_metadata(&mut input, path, &mut metadata)?;
+    Ok(metadata)
+}

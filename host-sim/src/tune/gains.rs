@@ -1,0 +1,12 @@
+//! The gains a tuning reads and proposes: the proportional and integral gain of one PI
+//! loop, the speed loop's (Table 1) or the pressure loop's schedule at one setpoint.
+
+/// Proportional and integral gain of a PI. Speed: [A/(rad/s)], [A/rad]; pressure:
+/// [(rad/s)/Pa], [(rad/s)/(Pa·s)].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gains {
+    /// Proportional gain.
+    pub kp: f64,
+    /// Integral gain.
+    pub ki: f64,
+}
