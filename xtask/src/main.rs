@@ -86,6 +86,7 @@ fn test() -> Result<()> {
             "warnings",
         ]),
     )?;
+    rooms::rooms(&[])?;
     run("host tests", cargo().args(["test", "--workspace"]))?;
     fleet_check::check(&python)?;
     let text = dbc::generate(dbc::DEFAULT_NODE)?;
