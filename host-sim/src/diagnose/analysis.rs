@@ -217,7 +217,7 @@ pub fn analyse_reporting(
     rig.validate()?;
     // 1. Facts.
     let facts = LogFacts::of(log, rig);
-    let motion = ShaftMotion::of(log, &facts);
+    let motion = ShaftMotion::of(log, &facts, rig.motor.pole_pairs);
     let rel = Relations::of(log, &facts, &motion, rig, precision);
     progress.step("calibration");
     // 2. Calibration.

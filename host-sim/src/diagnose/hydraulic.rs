@@ -323,25 +323,22 @@ impl Hydraulics {
                 let volume = hp.high_side_volume_m3 + hp.area_m2 * (x0 + f * dx);
                 volume.max(1e-9) / hp.bulk_modulus_pa
             };
-            if !ripple && dx == 0.0 {
-                let (q_in, c_oil) = (q_at(1.0), c_at(0.0));
-                for _ in 0..steps {
-                    for st in st.iter_mut() {
-                        self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
-                    }
-                }
-            } else {
-                for j in 0..steps {
+            let uniform = !ripple && dx == 0.0;
+            let row = (q_at(1.0), c_at(0.0));
+            for j in 0..steps {
+                let (q_in, c_oil) = if uniform {
+                    row
+                } else {
                     let f = (j as f64 + 0.5) / steps as f64;
                     let factor = if ripple {
                         self.pump.displacement_factor(x.theta_rad[k] + f * dtheta)
                     } else {
                         1.0
                     };
-                    let (q_in, c_oil) = (q_at(factor), c_at(f));
-                    for st in st.iter_mut() {
-                        self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
-                    }
+                    (q_at(factor), c_at(f))
+                };
+                for st in st.iter_mut() {
+                    self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
                 }
             }
             for (o, st) in out.iter_mut().zip(&st) {

@@ -30,7 +30,6 @@ use plant_model::Rig;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::PI;
 use std::ops::Range;
-use std::sync::OnceLock;
 
 /// Time on each side of the central differences that give speed and acceleration (five
 /// rows of a 1 kHz log): a span in time, so a faster log's encoder quantisation is not
@@ -115,9 +114,10 @@ pub struct ShaftMotion {
     /// The Coulomb friction's sign, faded through zero speed: tanh(ω/[`COULOMB_FADE_RAD_S`])
     /// at the shaft's speed, computed once for every fit that scales it. [1]
     pub coulomb_shape: Vec<f64>,
-    /// The unit phasors of the shaft angle θ and of the electrical angle p_n·θ at every row,
-    /// made at the first evaluation that needs them, with the p_n they were made for.
-    phasors: OnceLock<(f64, Vec<[Phasor; 2]>)>,
+    /// The unit phasors of the shaft angle θ and of the electrical angle p_n·θ at every row:
+    /// the cogging torque, the flux harmonics and the pump's ripple are evaluated at them in
+    /// every fit. [1]
+    pub rotation: Vec<[Phasor; 2]>,
     /// How the acceleration was read: what it keeps of a line ([`ShaftMotion::accel_gain`]).
     pub accel_filter: AccelFilter,
 }
@@ -184,9 +184,9 @@ pub fn savgol_second_derivative(y: &[f64], period: f64, m: usize) -> Vec<f64> {
 }
 
 impl ShaftMotion {
-    /// The shaft's motion in `log`, its acceleration keeping the angle-locked orders
-    /// ([`savgol_second_derivative`]).
-    pub fn of(log: &BenchLog, facts: &LogFacts) -> ShaftMotion {
+    /// The shaft's motion in `log` on a motor of `pole_pairs`, its acceleration keeping the
+    /// angle-locked orders ([`savgol_second_derivative`]).
+    pub fn of(log: &BenchLog, facts: &LogFacts, pole_pairs: u32) -> ShaftMotion {
         let h = rows_spanning(RATE_HALF_WIDTH_S, facts.period_s, 1);
         let period = facts.period_s;
         let central = AccelFilter::Central { half: h, period };
@@ -208,30 +208,20 @@ impl ShaftMotion {
             .iter()
             .map(|w| (w / COULOMB_FADE_RAD_S).tanh())
             .collect();
+        let pp = pole_pairs as f64;
+        let rotation = facts
+            .theta_rad
+            .iter()
+            .map(|th| [Phasor::of(*th), Phasor::of(pp * th)])
+            .collect();
         ShaftMotion {
             coulomb_shape,
-            phasors: OnceLock::new(),
+            rotation,
             speed_rad_s: speed,
             accel_rad_s2: accel,
             iq_mean_a: mean_current(&log.iq_a, facts.period_s),
             accel_filter,
         }
-    }
-
-    /// The phasors of θ and of `pole_pairs`·θ at every row of `facts` (the log this motion
-    /// is of), computed once: the cogging torque, the flux harmonics and the pump's ripple
-    /// are evaluated at them in every fit.
-    fn phasors(&self, facts: &LogFacts, pole_pairs: f64) -> &[[Phasor; 2]] {
-        let (pp, v) = self.phasors.get_or_init(|| {
-            let v = facts
-                .theta_rad
-                .iter()
-                .map(|th| [Phasor::of(*th), Phasor::of(pole_pairs * th)])
-                .collect();
-            (pole_pairs, v)
-        });
-        debug_assert_eq!(*pp, pole_pairs, "one motor per log's motion");
-        v
     }
 
     /// The fraction of a shaft oscillation's acceleration at angular frequency `w` that
@@ -363,7 +353,7 @@ impl Mechanics {
     ) {
         let j = self.params.inertia_kg_m2;
         let slow = &motion.iq_mean_a;
-        let rotation = motion.phasors(facts, self.params.motor.pole_pairs as f64);
+        let rotation = &motion.rotation;
         let base = rows.start;
         for k in rows {
             let w = motion.speed_rad_s[k];
@@ -391,7 +381,7 @@ impl Mechanics {
         let t = &log.t_s;
         let j = self.params.inertia_kg_m2.max(1e-12);
         let slow = &motion.iq_mean_a;
-        let rotation = motion.phasors(facts, self.params.motor.pole_pairs as f64);
+        let rotation = &motion.rotation;
         for win in windows {
             let mut w = motion.speed_rad_s[win.start];
             out[win.start] = w;
@@ -519,7 +509,7 @@ mod tests {
         };
         log.metadata.clear();
         let facts = LogFacts::of(&log, &rig);
-        let motion = ShaftMotion::of(&log, &facts);
+        let motion = ShaftMotion::of(&log, &facts, rig.motor.pole_pairs);
         let mech = Mechanics::new(MechanicalParams::nominal(&rig));
         let mut out = vec![0.0; n];
         mech.needed_current(&log, &facts, &motion, 0..n, &mut out);
