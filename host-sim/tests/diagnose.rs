@@ -141,7 +141,8 @@ fn a_ten_kilohertz_log_is_read_as_a_one_kilohertz_log_is() {
     // counted would differentiate the encoder's counts ten times harder), and a leakage
     // is measured as at 1 kHz. The bound leaves room for the speed estimate, which the
     // controller updates at 2 kHz and the 10 kHz log holds for five rows, so its
-    // second differences understate its noise.
+    // second differences understate its noise. The diagnosis reads a log faster than
+    // about 2 kHz at that rate (every k-th row as logged).
     let run = |rate: &'static str| ["--log-rate", rate, "--duration", "6"];
     let (slow, _) = diagnose("nominal-1khz", "pressure-step", None, &run("1000"));
     let (fast, _) = diagnose("nominal-10khz", "pressure-step", None, &run("10000"));
@@ -156,9 +157,20 @@ fn a_ten_kilohertz_log_is_read_as_a_one_kilohertz_log_is() {
             "{signal}: residual {b:.2}× its noise at 10 kHz, {a:.2}× at 1 kHz"
         );
     }
+    // The leak shows in the holding speed: 12 s, so that both segments hold (the rise at
+    // the speed limit lasts 3 s).
     let leak = Some("extra_leakage:coefficient_m3_s_pa=5e-13");
-    let (v, _) = diagnose("leakage-10khz", "pressure-step", leak, &run("10000"));
+    let long = ["--log-rate", "10000", "--duration", "12"];
+    let (v, _) = diagnose("leakage-10khz", "pressure-step", leak, &long);
     assert_eq!(lead(&v), "extra_leakage", "{v:#}");
+    // Named alone (no transducer lag accused on the tenfold rows), from the rows 0.45 ms
+    // apart at least: every fifth of the 120 000, 24 000.
+    assert_eq!(
+        v["extended"]["effects"],
+        serde_json::json!(["extra_leakage"]),
+        "{v:#}"
+    );
+    assert_eq!(v["samples"], 24_000, "{v:#}");
     let c = param(&v, "coefficient_m3_s_pa");
     assert!((c / 5e-13 - 1.0).abs() < 0.2, "{c}");
 }

@@ -182,6 +182,43 @@ impl BenchLog {
         }
     }
 
+    /// The rows at least `min_interval_s` after the last row kept (the first row always),
+    /// as [`super::read_thinned`] keeps them; `None` when every row would be kept.
+    pub fn thinned(&self, min_interval_s: f64) -> Option<BenchLog> {
+        let mut keep = Vec::with_capacity(self.len());
+        for (k, &t) in self.t_s.iter().enumerate() {
+            if keep
+                .last()
+                .is_none_or(|&j: &usize| t - self.t_s[j] >= min_interval_s)
+            {
+                keep.push(k);
+            }
+        }
+        if keep.len() == self.len() {
+            return None;
+        }
+        let pick = |v: &Vec<f64>| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+        let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
+        Some(BenchLog {
+            metadata: self.metadata.clone(),
+            t_s: pick(&self.t_s),
+            p_ref_pa: pick(&self.p_ref_pa),
+            p_pa: pick(&self.p_pa),
+            speed_rad_s: pick(&self.speed_rad_s),
+            iq_a: pick(&self.iq_a),
+            id_a: pick(&self.id_a),
+            theta_m_rad: pick_opt(&self.theta_m_rad),
+            x_m: pick_opt(&self.x_m),
+            p_low_pa: pick_opt(&self.p_low_pa),
+            speed_ref_rad_s: pick_opt(&self.speed_ref_rad_s),
+            iq_ref_a: pick_opt(&self.iq_ref_a),
+            ud_v: pick_opt(&self.ud_v),
+            uq_v: pick_opt(&self.uq_v),
+            udc_v: pick_opt(&self.udc_v),
+            oil_temp_c: pick_opt(&self.oil_temp_c),
+        })
+    }
+
     /// The value of the first metadata line with `key`.
     pub fn meta(&self, key: &str) -> Option<&str> {
         self.metadata

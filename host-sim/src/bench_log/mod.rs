@@ -40,7 +40,7 @@ pub mod writer;
 
 pub use columns::{BenchLog, Signal, DRIVE_KEY, MIN_ROWS, RECORDED_AT_KEY};
 pub use error::{BenchLogError, Problem};
-pub use reader::{parse, read, read_metadata};
+pub use reader::{parse, read, read_metadata, read_thinned};
 pub use rules::time_problem;
 pub use writer::{format_value, stage, to_bytes, write, write_into};
 

@@ -15,6 +15,14 @@ use std::path::Path;
 
 /// Reads and checks a bench log.
 pub fn read(path: &Path) -> Result<BenchLog, BenchLogError> {
+    read_thinned(path, 0.0).map(|(log, _)| log)
+}
+
+/// Reads and checks a bench log, every row, but keeps only rows at least `min_interval_s`
+/// after the last row kept (the first row always): a log sampled faster than that is kept
+/// at about that interval, its rows unchanged, without holding the rest in memory. Returns
+/// the log and the number of rows the file holds.
+pub fn read_thinned(path: &Path, min_interval_s: f64) -> Result<(BenchLog, usize), BenchLogError> {
     let io_err = |source| BenchLogError::Read {
         file: path.to_path_buf(),
         source,
@@ -23,11 +31,20 @@ pub fn read(path: &Path) -> Result<BenchLog, BenchLogError> {
         return Err(io_err(io::Error::new(io::ErrorKind::InvalidInput, why)));
     }
     let file = File::open(path).map_err(io_err)?;
-    parse(BufReader::new(file), path)
+    parse_thinned(BufReader::new(file), path, min_interval_s)
 }
 
 /// Parses a bench log from `input`; `path` names it in errors.
 pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> {
+    parse_thinned(input, path, 0.0).map(|(log, _)| log)
+}
+
+/// [`parse`], keeping the rows [`read_thinned`] keeps; returns the log and the rows read.
+fn parse_thinned<R: Read>(
+    input: R,
+    path: &Path,
+    min_interval_s: f64,
+) -> Result<(BenchLog, usize), BenchLogError> {
     let err = |line: usize, column: &str, problem: Problem| BenchLogError::Content {
         file: path.to_path_buf(),
         line,
@@ -105,13 +122,18 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
     let most_rows = limits::max_rows(known.len());
 
     let mut last_line = header_line;
+    // Rows read, the previous row's time (the rules compare neighbours in the file) and
+    // the row's values before it is kept or dropped.
+    let mut rows = 0usize;
+    let mut previous_t: Option<f64> = None;
+    let mut values = vec![0.0; known.len()];
     while reader
         .read_record(&mut record)
         .map_err(|e| csv_err(e, last_line + 1))?
     {
         let line = line_of(&record, last_line + 1);
         last_line = line;
-        if log.len() == most_rows {
+        if rows == most_rows {
             let problem = Problem::TooManyRows { most: most_rows };
             return Err(err(line, Signal::Time.name(), problem));
         }
@@ -130,7 +152,7 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
                 },
             ));
         }
-        for &(i, s) in &known {
+        for (slot, &(i, s)) in values.iter_mut().zip(&known) {
             let text = record.get(i).unwrap_or("");
             let v = match text.parse::<f64>() {
                 Ok(v) if v.is_finite() => v,
@@ -149,21 +171,29 @@ pub fn parse<R: Read>(input: R, path: &Path) -> Result<BenchLog, BenchLogError> 
                 return Err(err(line, s.name(), beyond(s, v)));
             }
             if s == Signal::Time {
-                if let Some(problem) = log.t_s.last().and_then(|p| time_problem(*p, v)) {
+                if let Some(problem) = previous_t.and_then(|p| time_problem(p, v)) {
                     return Err(err(line, s.name(), problem));
                 }
+                previous_t = Some(v);
             }
-            log.column_mut(s).push(v);
+            *slot = v;
+        }
+        rows += 1;
+        let t = previous_t.unwrap_or(0.0);
+        if log.t_s.last().is_none_or(|kept| t - kept >= min_interval_s) {
+            for (&v, &(_, s)) in values.iter().zip(&known) {
+                log.column_mut(s).push(v);
+            }
         }
     }
-    if log.len() < MIN_ROWS {
+    if rows < MIN_ROWS {
         return Err(err(
             last_line,
             Signal::Time.name(),
-            Problem::TooFewRows { rows: log.len() },
+            Problem::TooFewRows { rows },
         ));
     }
-    Ok(log)
+    Ok((log, rows))
 }
 
 /// Reads the `# key: value` lines (and blank lines) before the header of `input` into

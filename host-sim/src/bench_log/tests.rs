@@ -302,3 +302,44 @@ fn drive_and_recorded_at_are_kept_and_read_alone_from_the_head() {
     assert!(e.to_string().contains("absent.csv"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_thinned_read_keeps_rows_the_interval_apart_and_still_checks_every_row() {
+    // 10 kHz rows (0.1 ms) read at 0.45 ms at least: every fifth row, as logged.
+    let fast = |i: usize| format!("{},5e6,{},6.0,1.5,0", i as f64 * 1e-4, 5e6 + i as f64);
+    let dir = std::env::temp_dir().join(format!("eha-thin-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("fast.csv");
+    std::fs::write(&path, log_text(1000, HEADER, fast)).unwrap();
+    let (log, rows) = read_thinned(&path, 0.45e-3).unwrap();
+    assert_eq!(rows, 1000);
+    assert_eq!(log.len(), 200);
+    for (k, (&t, &p)) in log.t_s.iter().zip(&log.p_pa).enumerate() {
+        assert!((t - k as f64 * 5e-4).abs() < 1e-12, "row {k}: t = {t}");
+        assert_eq!(
+            p,
+            5e6 + (5 * k) as f64,
+            "row {k}: the logged value, unfiltered"
+        );
+    }
+    // The same rows as thinning the whole log, and a 1 kHz log is left whole.
+    let whole = read(&path).unwrap();
+    assert_eq!(whole.thinned(0.45e-3).as_ref(), Some(&log));
+    assert_eq!(log.thinned(0.45e-3), None);
+    // A fault in a row the thinning skips (row 3, not a fifth) is still reported there.
+    let bad = log_text(1000, HEADER, |i| {
+        if i == 3 {
+            "3e-4,5e6,x,6,1.5,0".into()
+        } else {
+            fast(i)
+        }
+    });
+    std::fs::write(&path, bad).unwrap();
+    match read_thinned(&path, 0.45e-3).unwrap_err() {
+        BenchLogError::Content { line, column, .. } => {
+            assert_eq!((line, column.as_str()), (7, "p_pa"))
+        }
+        e => panic!("expected a content error, got {e}"),
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,7 +1,7 @@
 //! `eha diagnose LOG.csv [--json PATH] [--report DIR]`: reads the log, diagnoses it against
 //! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
-use super::analysis::{analyse_reporting, Precision, STEPS};
+use super::analysis::{analyse_reporting, Precision, MIN_ANALYSED_INTERVAL_S, STEPS};
 use super::error::DiagnoseError;
 use crate::output::paths::Declared;
 use crate::output::{CliError, Outputs};
@@ -59,8 +59,16 @@ fn input_or_failure(e: DiagnoseError, log: &std::path::Path) -> CliError {
 
 /// `eha diagnose`.
 pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
-    let log = crate::bench_log::read(&args.log)?;
+    let (log, rows) = crate::bench_log::read_thinned(&args.log, MIN_ANALYSED_INTERVAL_S)?;
     crate::bench_log::replayable::check(&log, rig, &args.log)?;
+    let read_as = if rows > log.len() {
+        format!(
+            " of {rows} rows (a row closer than {:.2} ms to the last one read is skipped)",
+            MIN_ANALYSED_INTERVAL_S * 1e3
+        )
+    } else {
+        String::new()
+    };
     let bar = crate::output::progress::steps(
         STEPS,
         format!("diagnosing {} ({} rows)", args.log.display(), log.len()),
@@ -75,7 +83,7 @@ pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
     let d = &analysis.diagnosis;
     let mut text = String::new();
     text.push_str(&format!(
-        "{}: {} samples; identification {:.3}–{:.3} s, validation {:.3}–{:.3} s\n",
+        "{}: {} samples{read_as}; identification {:.3}–{:.3} s, validation {:.3}–{:.3} s\n",
         args.log.display(),
         d.samples,
         d.identification_segment_s[0],
