@@ -12,8 +12,9 @@
 //! b and a (at the weighted mean time t̄, where they are uncorrelated) have variances
 //! 1/Σ w_i·(t_i − t̄)² and 1/Σ w_i.
 //!
-//! A drift is flagged when b/SE(b), referred to Student's t with n − 2 degrees of freedom
-//! (τ² is estimated from the same points), is significant at the two-sided level
+//! A drift is flagged when b/SE(b), referred to Student's t with n_eff − 2 degrees of
+//! freedom (τ² is estimated from the same points; n_eff = (Σw)²/Σw², Kish's effective
+//! number of points, is n when the weights are equal), is significant at the two-sided level
 //! [`FALSE_ALARM`]. The line crosses a limit L at t_c = t̄ + (L − a)/b, with the standard
 //! error (delta method) √(Var a + (t_c − t̄)²·Var b)/|b|.
 
@@ -139,8 +140,20 @@ fn between_log_variance(points: &[Point]) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// Kish's effective number of points of weights `w`, (Σw)²/Σw²: n for equal weights, about
+/// k when k points outweigh the rest.
+fn effective_points(w: &[f64]) -> f64 {
+    let (s1, s2) = w.iter().fold((0.0, 0.0), |(a, b), w| (a + w, b + w * w));
+    s1 * s1 / s2
+}
+
 /// Fits the trend; `None` with fewer than [`MIN_POINTS`] usable points (finite value and
-/// time, finite positive standard error) or when they all share one time.
+/// time, finite positive standard error), when they all share one time, or when their
+/// weights leave fewer than [`MIN_POINTS`] effective points ([`effective_points`]): a
+/// parameter most logs cannot tell apart (standard errors of 1e9 and more beside a few of
+/// 1e5) would otherwise be a line through its two or three sharpest estimates, tested as
+/// if it stood on them all. The drift test's degrees of freedom are the effective points
+/// less two.
 pub fn fit(points: &[Point]) -> Option<Trend> {
     let points: Vec<Point> = points
         .iter()
@@ -155,10 +168,16 @@ pub fn fit(points: &[Point]) -> Option<Trend> {
         return None;
     }
     let tau2 = between_log_variance(&points);
-    let (t_bar, a, b, sw, stt, _) = weighted_line(&points, &weights(&points, tau2));
+    let w = weights(&points, tau2);
+    let effective = effective_points(&w);
+    // (Equal weights give n up to rounding.)
+    if effective < MIN_POINTS as f64 * (1.0 - 1e-9) {
+        return None;
+    }
+    let (t_bar, a, b, sw, stt, _) = weighted_line(&points, &w);
     let rate_se = (1.0 / stt).sqrt();
     let t_statistic = b / rate_se;
-    let dof = (points.len() - 2) as f64;
+    let dof = effective - 2.0;
     let p_value = StudentsT::new(0.0, 1.0, dof)
         .map(|d| 2.0 * d.sf(t_statistic.abs()))
         .unwrap_or(f64::NAN);
@@ -310,6 +329,24 @@ mod tests {
             let (u, v) = (self.unit(), self.unit());
             (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
         }
+    }
+
+    #[test]
+    fn a_line_carried_by_two_sharp_estimates_is_no_trend() {
+        // 28 logs that cannot tell the parameter (standard error 1e9 about 6.9e8) and two,
+        // two years apart, that claim 2e5 and differ by 7e6: by weight the line stands on
+        // two points (Kish: (Σw)²/Σw² ≈ 2), which cannot show a drift.
+        let mut pts: Vec<Point> = (0..30)
+            .map(|k| point(30.4 * k as f64, 6.9e8, 1e9))
+            .collect();
+        pts[2] = point(60.8, 6.91e8, 2e5);
+        pts[26] = point(790.4, 6.84e8, 2e5);
+        assert!(fit(&pts).is_none());
+        // The same values with equal errors are 30 points and a fit.
+        for p in &mut pts {
+            p.se = 2e5;
+        }
+        assert_eq!(fit(&pts).unwrap().points, 30);
     }
 
     #[test]
