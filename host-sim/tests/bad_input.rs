@@ -1387,3 +1387,36 @@ fn a_pressure_sensor_lag_shorter_than_the_step_simulates_stably() {
         );
     }
 }
+
+#[test]
+fn the_demo_folder_is_written_whole_or_not_at_all() {
+    // `eha demo --out D` has one output, its folder: a full disk or an interrupt while it
+    // is staged leaves a fresh D absent (not an empty folder) and an earlier D as it was,
+    // with no staging folder beside it.
+    let dir = scratch("demo-transaction");
+    let out = dir.join("d");
+    let demo = |env: &[(&str, &str)]| eha_with(env, &["demo", "--out", s(&out)]);
+    let o = demo(&[("EHA_TEST_FULL_AT", "staged:1")]);
+    assert_eq!(status(&o), 1, "{}", stderr(&o));
+    assert!(stderr(&o).contains("no output written"), "{}", stderr(&o));
+    assert!(entries(&dir).is_empty(), "{:?}", entries(&dir));
+    let o = demo(&[("EHA_TEST_INTERRUPT_AT", "staged:1")]);
+    assert_eq!(status(&o), 130, "{}", stderr(&o));
+    assert!(entries(&dir).is_empty(), "{:?}", entries(&dir));
+    let o = demo(&[]);
+    assert_eq!(status(&o), 0, "{}", stderr(&o));
+    let was = contents(&out);
+    assert!(
+        was.iter().any(|(n, _)| n == "pressure_trace.png"),
+        "{was:?}"
+    );
+    for env in [
+        ("EHA_TEST_FULL_AT", "staged:1"),
+        ("EHA_TEST_INTERRUPT_AT", "staged:1"),
+    ] {
+        let o = demo(&[env]);
+        assert_ne!(status(&o), 0, "{env:?}");
+        assert_eq!(contents(&out), was, "{env:?}: the folder as it was");
+        assert_eq!(entries(&dir), ["d"], "{env:?}: no staging folder");
+    }
+}
