@@ -145,6 +145,12 @@ pub struct BenchLog {
     pub oil_temp_c: Option<Vec<f64>>,
 }
 
+/// Whether a row at time `t_s` is kept after the last kept row's time `last_kept_s` when
+/// rows are kept at least `min_interval_s` apart (the first row always). [s]
+pub(super) fn keeps_row(last_kept_s: Option<f64>, t_s: f64, min_interval_s: f64) -> bool {
+    last_kept_s.is_none_or(|last| t_s - last >= min_interval_s)
+}
+
 impl BenchLog {
     /// Number of samples (rows).
     pub fn len(&self) -> usize {
@@ -186,37 +192,24 @@ impl BenchLog {
     /// as [`super::read_thinned`] keeps them; `None` when every row would be kept.
     pub fn thinned(&self, min_interval_s: f64) -> Option<BenchLog> {
         let mut keep = Vec::with_capacity(self.len());
+        let mut last = None;
         for (k, &t) in self.t_s.iter().enumerate() {
-            if keep
-                .last()
-                .is_none_or(|&j: &usize| t - self.t_s[j] >= min_interval_s)
-            {
+            if keeps_row(last, t, min_interval_s) {
                 keep.push(k);
+                last = Some(t);
             }
         }
         if keep.len() == self.len() {
             return None;
         }
-        let pick = |v: &Vec<f64>| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
-        let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
-        Some(BenchLog {
+        let mut out = BenchLog {
             metadata: self.metadata.clone(),
-            t_s: pick(&self.t_s),
-            p_ref_pa: pick(&self.p_ref_pa),
-            p_pa: pick(&self.p_pa),
-            speed_rad_s: pick(&self.speed_rad_s),
-            iq_a: pick(&self.iq_a),
-            id_a: pick(&self.id_a),
-            theta_m_rad: pick_opt(&self.theta_m_rad),
-            x_m: pick_opt(&self.x_m),
-            p_low_pa: pick_opt(&self.p_low_pa),
-            speed_ref_rad_s: pick_opt(&self.speed_ref_rad_s),
-            iq_ref_a: pick_opt(&self.iq_ref_a),
-            ud_v: pick_opt(&self.ud_v),
-            uq_v: pick_opt(&self.uq_v),
-            udc_v: pick_opt(&self.udc_v),
-            oil_temp_c: pick_opt(&self.oil_temp_c),
-        })
+            ..BenchLog::default()
+        };
+        for (signal, column) in self.columns() {
+            *out.column_mut(signal) = keep.iter().map(|&k| column[k]).collect();
+        }
+        Some(out)
     }
 
     /// The value of the first metadata line with `key`.

@@ -3,7 +3,7 @@
 //! the rows, each value checked as it is read ([`super::rules`]) within the bounds of
 //! [`super::limits`]; the first fault is reported with its file, line and column.
 
-use super::columns::{BenchLog, Signal, MIN_ROWS};
+use super::columns::{keeps_row, BenchLog, Signal, MIN_ROWS};
 use super::error::{BenchLogError, Problem};
 use super::limits::{
     self, excerpt, line_too_long, LineLimited, MAX_METADATA_BYTES, MAX_METADATA_LINES,
@@ -180,7 +180,7 @@ fn parse_thinned<R: Read>(
         }
         rows += 1;
         let t = previous_t.unwrap_or(0.0);
-        if log.t_s.last().is_none_or(|kept| t - kept >= min_interval_s) {
+        if keeps_row(log.t_s.last().copied(), t, min_interval_s) {
             for (&v, &(_, s)) in values.iter().zip(&known) {
                 log.column_mut(s).push(v);
             }
