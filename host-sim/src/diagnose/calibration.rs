@@ -114,6 +114,12 @@ pub trait Relation: Sync {
     /// precharge far off is half-mimicked by displacement and shell volume); `None` when
     /// the relation does not offer `release`.
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)>;
+    /// How many local minima of `release`'s grid besides its best point are fitted as
+    /// well ([`release_starts`]): none unless the relation's objective is known to have
+    /// basins the held parameters misjudge.
+    fn grid_basins(&self, _release: Release) -> usize {
+        0
+    }
     /// The optimiser's patience on this relation (iterations per parameter).
     fn patience(&self) -> usize {
         PATIENCE
@@ -164,6 +170,9 @@ impl<R: Relation> Relation for Patient<'_, R> {
     fn correlation_bin(&self) -> usize {
         self.relation.correlation_bin()
     }
+    fn grid_basins(&self, release: Release) -> usize {
+        self.relation.grid_basins(release)
+    }
 }
 
 /// A relation with parameter `index` held at `value`: the best fit of the others there
@@ -201,6 +210,9 @@ impl<R: Relation> Relation for Pinned<'_, R> {
     }
     fn correlation_bin(&self) -> usize {
         self.relation.correlation_bin()
+    }
+    fn grid_basins(&self, release: Release) -> usize {
+        self.relation.grid_basins(release)
     }
 }
 
@@ -240,6 +252,9 @@ impl<R: Relation> Relation for Freed<'_, R> {
     }
     fn correlation_bin(&self) -> usize {
         self.relation.correlation_bin()
+    }
+    fn grid_basins(&self, release: Release) -> usize {
+        self.relation.grid_basins(release)
     }
 }
 
@@ -347,8 +362,12 @@ pub fn test_release<R: Relation>(
             .sum();
         weighed_sse(relation, v, rows, scale) + prior
     };
-    let start = release_start(relation, release, base, |v| objective_at(v, base.scale));
-    let first = fit_relation(relation, rows, release, base.scale, Some(&start));
+    let starts = release_starts(relation, release, base, |v| objective_at(v, base.scale));
+    let first = starts
+        .iter()
+        .map(|start| fit_relation(relation, rows, release, base.scale, Some(start)))
+        .min_by(|a, b| (a.data_sse + a.prior_sse).total_cmp(&(b.data_sse + b.prior_sse)))
+        .unwrap_or_else(|| fit_relation(relation, rows, release, base.scale, None));
     let scale = variance_per_independent_sample(
         &relation.residuals(&first.values, rows),
         relation.correlation_bin(),
@@ -395,12 +414,19 @@ pub fn test_release<R: Relation>(
 /// have pushed other tolerances to their band edges to mimic the effect (a smaller
 /// absorber shell and a larger displacement for a lower precharge); with them there, the
 /// effect's true value fits worse than the nominal one and a local search stays put.
-fn release_start<R: Relation>(
+///
+/// Besides it, up to [`Relation::grid_basins`] other grid points, the best-scoring first,
+/// each a few per cent apart along the released parameter from the starts already taken:
+/// the grid scores each point with the other parameters held, so of two basins the one
+/// they were calibrated near looks better than it is (a precharge below a shooting
+/// window's start pressure against one above it). Each start is fitted and the best fit
+/// kept.
+fn release_starts<R: Relation>(
     relation: &R,
     release: Release,
     base: &Calibration,
     objective: impl Fn(&[f64]) -> f64,
-) -> Vec<f64> {
+) -> Vec<Vec<f64>> {
     let specs = relation.specs(release);
     let base_specs = relation.specs(Release::Nothing);
     let grid = relation.released(release);
@@ -416,22 +442,40 @@ fn release_start<R: Relation>(
     };
     let calibrated = freed(base.fitted.values.clone());
     let Some((k, points)) = &grid else {
-        return calibrated;
+        return vec![calibrated];
     };
     let nominal = freed(base_specs.iter().map(|s| s.value(s.start)).collect());
     let mut best = (objective(&calibrated), calibrated.clone());
+    let mut scored: Vec<(f64, Vec<f64>)> = Vec::new();
     for from in [&calibrated, &nominal] {
         for g in points {
             let mut v = from.clone();
             v[*k] = *g;
             let o = objective(&v);
             if o < best.0 {
-                best = (o, v);
+                best = (o, v.clone());
+            }
+            if o.is_finite() {
+                scored.push((o, v));
             }
         }
     }
-    best.1
+    let mut starts = vec![best.1];
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, v) in scored {
+        if starts.len() > relation.grid_basins(release) {
+            break;
+        }
+        let apart = |s: &Vec<f64>| (v[*k] / s[*k]).abs().ln().abs() > DISTINCT_START_LN;
+        if starts.iter().all(apart) {
+            starts.push(v);
+        }
+    }
+    starts
 }
+
+/// Least log-ratio between two starts of one release's fits. [1]
+const DISTINCT_START_LN: f64 = 0.03;
 
 /// The weighed squared residuals of `relation` at `values` over `rows`. [1]
 pub fn weighed_sse<R: Relation>(

@@ -186,6 +186,50 @@ pub struct HydraulicRelation<'a> {
     pub rig: &'a Rig,
 }
 
+/// Closest ratio of two shooting-window start pressures between which the precharge grid
+/// takes a point of its own.
+const DISTINCT_START_RATIO: f64 = 1.03;
+
+/// Points of the precharge's grid fitted besides its best one.
+const PRECHARGE_BASINS: usize = 2;
+
+impl HydraulicRelation<'_> {
+    /// The released precharge's starting grid around the rig file's `p0`: 0.3–3 times it,
+    /// and a point between each two neighbouring start pressures of the identification's
+    /// shooting windows. A window starting at p_w starts its absorber empty when the
+    /// precharge lies above p_w and in equilibrium, filling at C(p_w)·ṗ, when it lies below:
+    /// on a rise the objective jumps where the precharge meets a start pressure, so it has
+    /// a basin between each two of them, and a local search from a point in another basin
+    /// stops at the jump. The grid has a point in each.
+    fn precharge_grid(&self, p0: f64) -> Vec<f64> {
+        let starts = self
+            .facts
+            .windows(self.facts.identification(), HYDRAULIC_WINDOW_S)
+            .iter()
+            .filter_map(|w| self.log.p_pa.get(w.start).copied())
+            .collect();
+        precharge_grid(p0, starts)
+    }
+}
+
+/// The precharge grid around `p0` with a point between each two neighbouring distinct
+/// window `starts` (pressures) within it ([`HydraulicRelation::precharge_grid`]).
+fn precharge_grid(p0: f64, mut starts: Vec<f64>) -> Vec<f64> {
+    let (lo, hi) = (0.3 * p0, 3.0 * p0);
+    let mut grid = scaled(p0, &[0.3, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0]);
+    starts.retain(|p| *p > lo && *p < hi);
+    starts.sort_by(f64::total_cmp);
+    let mut distinct: Vec<f64> = Vec::new();
+    for p in starts {
+        if distinct.last().is_none_or(|q| p > q * DISTINCT_START_RATIO) {
+            distinct.push(p);
+        }
+    }
+    grid.extend(distinct.windows(2).map(|w| (w[0] * w[1]).sqrt()));
+    grid.sort_by(f64::total_cmp);
+    grid
+}
+
 impl Relation for HydraulicRelation<'_> {
     fn facts(&self) -> &LogFacts {
         self.facts
@@ -206,13 +250,21 @@ impl Relation for HydraulicRelation<'_> {
                 hyd::BETA,
                 scaled(n.bulk_modulus_pa, &[1.0, 0.6, 0.35, 0.2, 0.1]),
             ),
-            Release::Precharge => (
-                hyd::PRECHARGE,
-                scaled(p0, &[0.3, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0]),
-            ),
+            Release::Precharge => (hyd::PRECHARGE, self.precharge_grid(p0)),
             Release::SensorLag => (hyd::LAG, vec![0.5e-3, 3e-3, 10e-3, 30e-3, 100e-3]),
             _ => return None,
         })
+    }
+
+    /// The precharge's objective has a basin between each two windows' start pressures
+    /// ([`Self::precharge_grid`]), and the grid, scoring each point with the other
+    /// parameters held, misjudges which one is deepest.
+    fn grid_basins(&self, release: Release) -> usize {
+        if release == Release::Precharge {
+            PRECHARGE_BASINS
+        } else {
+            0
+        }
     }
 
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
@@ -223,5 +275,35 @@ impl Relation for HydraulicRelation<'_> {
             hydraulic_params(self.rig, values),
             rows,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_precharge_grid_has_a_point_between_each_two_window_starts() {
+        // A rise through 1.1, 1.6, 2.0 and 2.5 MPa, two starts 1 % apart, a hold at 5 MPa
+        // and a start below the grid's range.
+        let starts = vec![5e6, 1.6e6, 0.5e6, 2.5e6, 2.0e6, 5e6, 1.1e6, 2.02e6, 5e6];
+        let grid = precharge_grid(3e6, starts);
+        for pair in [
+            (1.1e6, 1.6e6),
+            (1.6e6, 2.0e6),
+            (2.02e6, 2.5e6),
+            (2.5e6, 5e6),
+        ] {
+            assert!(
+                grid.iter().any(|g| *g > pair.0 && *g < pair.1),
+                "nothing between {pair:?} in {grid:?}"
+            );
+        }
+        assert!(grid.windows(2).all(|w| w[0] <= w[1]), "{grid:?}");
+        assert_eq!(grid.first(), Some(&(0.3 * 3e6)));
+        assert_eq!(grid.last(), Some(&(3.0 * 3e6)));
+        // The rig file's seven points and one between each two of the five distinct starts
+        // in range (1.1, 1.6, 2.0, 2.5, 5 MPa; 2.02 within 3 % of 2.0).
+        assert_eq!(grid.len(), 7 + 4, "{grid:?}");
     }
 }
