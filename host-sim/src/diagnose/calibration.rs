@@ -114,9 +114,9 @@ pub trait Relation: Sync {
     /// precharge far off is half-mimicked by displacement and shell volume); `None` when
     /// the relation does not offer `release`.
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)>;
-    /// How many local minima of `release`'s grid besides its best point are fitted as
-    /// well ([`release_starts`]): none unless the relation's objective is known to have
-    /// basins the held parameters misjudge.
+    /// How many more points of `release`'s grid besides its best one are fitted as well
+    /// ([`release_starts`]): none unless the relation's objective is known to have basins
+    /// the grid, scoring with the other parameters held, misjudges.
     fn grid_basins(&self, _release: Release) -> usize {
         0
     }
@@ -362,12 +362,17 @@ pub fn test_release<R: Relation>(
             .sum();
         weighed_sse(relation, v, rows, scale) + prior
     };
-    let starts = release_starts(relation, release, base, |v| objective_at(v, base.scale));
-    let first = starts
-        .iter()
-        .map(|start| fit_relation(relation, rows, release, base.scale, Some(start)))
-        .min_by(|a, b| (a.data_sse + a.prior_sse).total_cmp(&(b.data_sse + b.prior_sse)))
-        .unwrap_or_else(|| fit_relation(relation, rows, release, base.scale, None));
+    let (best, others) = release_starts(relation, release, base, |v| objective_at(v, base.scale));
+    let fit_from = |start: &[f64]| fit_relation(relation, rows, release, base.scale, Some(start));
+    let objective = |f: &Fitted| f.data_sse + f.prior_sse;
+    let first = others.iter().fold(fit_from(&best), |kept, start| {
+        let f = fit_from(start);
+        if objective(&f) < objective(&kept) {
+            f
+        } else {
+            kept
+        }
+    });
     let scale = variance_per_independent_sample(
         &relation.residuals(&first.values, rows),
         relation.correlation_bin(),
@@ -415,7 +420,7 @@ pub fn test_release<R: Relation>(
 /// absorber shell and a larger displacement for a lower precharge); with them there, the
 /// effect's true value fits worse than the nominal one and a local search stays put.
 ///
-/// Besides it, up to [`Relation::grid_basins`] other grid points, the best-scoring first,
+/// Returned with it, up to [`Relation::grid_basins`] other grid points, the best-scoring first,
 /// each a few per cent apart along the released parameter from the starts already taken:
 /// the grid scores each point with the other parameters held, so of two basins the one
 /// they were calibrated near looks better than it is (a precharge below a shooting
@@ -426,7 +431,7 @@ fn release_starts<R: Relation>(
     release: Release,
     base: &Calibration,
     objective: impl Fn(&[f64]) -> f64,
-) -> Vec<Vec<f64>> {
+) -> (Vec<f64>, Vec<Vec<f64>>) {
     let specs = relation.specs(release);
     let base_specs = relation.specs(Release::Nothing);
     let grid = relation.released(release);
@@ -442,7 +447,7 @@ fn release_starts<R: Relation>(
     };
     let calibrated = freed(base.fitted.values.clone());
     let Some((k, points)) = &grid else {
-        return vec![calibrated];
+        return (calibrated, Vec::new());
     };
     let nominal = freed(base_specs.iter().map(|s| s.value(s.start)).collect());
     let mut best = (objective(&calibrated), calibrated.clone());
@@ -460,18 +465,18 @@ fn release_starts<R: Relation>(
             }
         }
     }
-    let mut starts = vec![best.1];
+    let mut others: Vec<Vec<f64>> = Vec::new();
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
     for (_, v) in scored {
-        if starts.len() > relation.grid_basins(release) {
+        if others.len() >= relation.grid_basins(release) {
             break;
         }
         let apart = |s: &Vec<f64>| (v[*k] / s[*k]).abs().ln().abs() > DISTINCT_START_LN;
-        if starts.iter().all(apart) {
-            starts.push(v);
+        if apart(&best.1) && others.iter().all(apart) {
+            others.push(v);
         }
     }
-    starts
+    (best.1, others)
 }
 
 /// Least log-ratio between two starts of one release's fits. [1]
