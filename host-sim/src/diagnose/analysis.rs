@@ -19,6 +19,7 @@ use super::candidates::{from_release, test_lines, test_relation, Extension, Test
 use super::contributions::contributions;
 use super::cylinder::{self};
 use super::diagnosis::Diagnosis;
+use super::displacement;
 use super::error::DiagnoseError;
 use super::facts::LogFacts;
 use super::findings::Analysis;
@@ -271,6 +272,11 @@ pub fn analyse_reporting(
     progress.step("predictions");
     // 5. Selection: every effect the log convicts.
     let (named, hydraulic_values) = select(&rel, &mut tested, rig);
+    if let Some(d) = displacement::from_shaft(&cal.mechanical, cal.electrical.as_ref(), rig) {
+        if !facts.piston_moves {
+            displacement::read_volumes_at(&mut tested, d, rig);
+        }
+    }
     // 6. Predictions and scores.
     let ctx = Context {
         log,

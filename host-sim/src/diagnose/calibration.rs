@@ -24,7 +24,9 @@
 //! With the cylinder blocked every volume of the hydraulic relation is relative to the pump
 //! displacement (scaling D and all volumes together leaves p(θ) unchanged): there the
 //! fit may settle anywhere along that direction within the bands; a moving piston's A·x is
-//! an absolute volume and fixes D.
+//! an absolute volume and fixes D. On a blocked cylinder the torque balance and the stator
+//! voltages fix D instead, and the volume balance's readings are taken at it
+//! ([`super::displacement`]).
 //!
 //! The relations themselves live beside: [`super::hydraulic_relation`] and
 //! [`super::mechanical_relation`] (the electrical and cylinder ones in their own modules).

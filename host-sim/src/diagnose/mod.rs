@@ -17,6 +17,8 @@
 //!   windows and the effects that make them; [`loop_response`]: the Table 1 loops'
 //!   responses the line readings use.
 //! - [`candidates`], [`decision`]: every effect tested, and the one the log convicts.
+//! - [`displacement`]: the pump's displacement fixed by the torque balance and the stator
+//!   voltages, at which a blocked cylinder's leakage and bulk modulus are read.
 //! - [`predictions`]: the contract's per-signal predictions and scores ([`fit_score`]).
 //! - [`signatures`], [`spectrum`]: the baseline residuals' time-domain signatures and
 //!   order spectra, for the report.
@@ -35,6 +37,7 @@ pub mod cylinder;
 pub mod dead_time;
 pub mod decision;
 pub mod diagnosis;
+pub mod displacement;
 pub mod electrical;
 mod error;
 pub mod facts;
