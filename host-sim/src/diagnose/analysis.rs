@@ -271,12 +271,10 @@ pub fn analyse_reporting(
     tested.extend(line_tests);
     progress.step("predictions");
     // 5. Selection: every effect the log convicts.
-    let (named, hydraulic_values) = select(&rel, &mut tested, rig);
-    if let Some(d) = displacement::from_shaft(&cal.mechanical, cal.electrical.as_ref(), rig) {
-        if !facts.piston_moves {
-            displacement::read_volumes_at(&mut tested, d, rig);
-        }
-    }
+    // A blocked cylinder's volume balance is read at the displacement the shaft fixes.
+    let displacement = displacement::from_shaft(&cal.mechanical, cal.electrical.as_ref(), rig)
+        .filter(|_| !facts.piston_moves);
+    let (named, hydraulic_values) = select(&rel, &mut tested, rig, displacement);
     // 6. Predictions and scores.
     let ctx = Context {
         log,

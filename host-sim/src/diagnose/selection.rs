@@ -25,6 +25,7 @@ use super::ambiguity::mark;
 use super::calibration::{calibrate, test_release, Calibration, Freed, Relation, Release};
 use super::candidates::{from_release, Extension, Tested};
 use super::decision::{apply_vetoes, threshold, why_not};
+use super::displacement::{read_volumes_at, Displacement};
 use super::relations::Relations;
 use plant_model::Rig;
 
@@ -43,12 +44,14 @@ fn family(t: &Tested) -> Family {
 }
 
 /// The effects named, as indices into `tested` (whose hydraulic entries are replaced by
-/// their tests against the model extended by the others), the strongest first; and the
+/// their tests against the model extended by the others, their volume balance's readings
+/// taken at `displacement` when the shaft fixes it), the strongest first; and the
 /// hydraulic relation's values with every named hydraulic effect released.
 pub(super) fn select(
     rel: &Relations<'_>,
     tested: &mut [Tested],
     rig: &Rig,
+    displacement: Option<Displacement>,
 ) -> (Vec<usize>, Option<Vec<f64>>) {
     apply_vetoes(tested);
     let first: Vec<f64> = tested.iter().map(|t| t.lambda).collect();
@@ -65,6 +68,10 @@ pub(super) fn select(
         }
     }
     let (hydraulic, values) = forward_hydraulic(rel, tested, rig);
+    // Before the ambiguities are marked: they are said in the readings' terms.
+    if let Some(d) = displacement {
+        read_volumes_at(tested, d, rig);
+    }
     named.extend(hydraulic);
     named.sort_by(|a, b| strength(&tested[*b]).total_cmp(&strength(&tested[*a])));
     mark(
