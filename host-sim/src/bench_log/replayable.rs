@@ -37,6 +37,12 @@ pub const GAP_FACTOR: f64 = 20.0;
 /// Shortest interval counted as a gap, whatever the sampling rate. [s]
 pub const MIN_GAP_S: f64 = 0.1;
 
+/// How far past the rig's stroke, as a fraction of the half stroke, a logged position may
+/// read: a piston pressed into an end stop compresses it (the rig's stops are springs), and
+/// a position sensor's zero is set to a fraction of a millimetre. A log in millimetres, or
+/// of another cylinder, reads far beyond. [1]
+pub const STROKE_MARGIN: f64 = 0.05;
+
 /// Checks `log` (read from `file`, named in errors) against the replays' needs on `rig`.
 pub fn check(log: &BenchLog, rig: &Rig, file: &Path) -> Result<(), BenchLogError> {
     let at = |row: usize, column: &str, why: String| BenchLogError::Replay {
@@ -124,15 +130,17 @@ pub fn check(log: &BenchLog, rig: &Rig, file: &Path) -> Result<(), BenchLogError
     }
     if let Some(x) = &log.x_m {
         let h = rig.cylinder.half_stroke_m;
-        if let Some(k) = x.iter().position(|v| v.abs() > h) {
+        let most = h * (1.0 + STROKE_MARGIN);
+        if let Some(k) = x.iter().position(|v| v.abs() > most) {
             return Err(at(
                 k,
                 "x_m",
                 format!(
                     "the piston position {} m lies outside the rig's stroke of ±{h} m \
-                     (cylinder.half_stroke_m): is the log of this rig (--rig), its position in \
-                     metres from mid-stroke?",
-                    x[k]
+                     (cylinder.half_stroke_m) by more than an end stop's give ({:.0} %): is \
+                     the log of this rig (--rig), its position in metres from mid-stroke?",
+                    x[k],
+                    100.0 * STROKE_MARGIN
                 ),
             ));
         }
@@ -156,6 +164,25 @@ mod tests {
             id_a: vec![0.0; n],
             ..BenchLog::default()
         }
+    }
+
+    #[test]
+    fn a_piston_pressed_into_its_end_stop_is_replayed_and_one_in_millimetres_is_not() {
+        let rig = Rig::nominal();
+        let h = rig.cylinder.half_stroke_m;
+        let file = Path::new("stroke.csv");
+        let mut log = log_of(2000);
+        // Against the stop at 1e5 N, the nominal stop's 2e8 N/m gives 0.5 mm.
+        let pressed = h + 1e5 / rig.cylinder.end_stop_stiffness_n_per_m;
+        log.x_m = Some(
+            (0..2000)
+                .map(|k| if k < 1000 { 0.0 } else { pressed })
+                .collect(),
+        );
+        check(&log, &rig, file).unwrap();
+        log.x_m = Some(vec![1e3 * h * 0.5; 2000]);
+        let text = check(&log, &rig, file).unwrap_err().to_string();
+        assert!(text.contains("x_m") && text.contains("stroke"), "{text}");
     }
 
     #[test]
