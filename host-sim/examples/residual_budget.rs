@@ -4,7 +4,8 @@
 //! transient (within [`GUARD_S`] of a speed reversal, of a jump of the speed reference, or
 //! of the q current leaving its reference by more than [`FOLLOWING_A`]: the current loop
 //! at its voltage or current limit) and the rest; and the share of the residual's energy
-//! in those transient rows against their share of the time.
+//! in those transient rows against their share of the time. The ratios are read on the
+//! rows the analysis keeps of its traces (every k-th row, a few thousand a log).
 //!
 //! ```text
 //! cargo run --release -p host-sim --example residual_budget -- LOG.csv…
@@ -50,7 +51,14 @@ fn main() {
         let rows: Vec<usize> = (0..a.t_s.len())
             .filter(|&k| a.t_s[k] >= v0 && a.t_s[k] <= v1)
             .collect();
-        let transient = transient_rows(&log, &a.t_s);
+        // The analysis keeps every k-th row of its traces: the transients are found on the
+        // whole log and read at those rows' times.
+        let whole = transient_rows(&log, &log.t_s);
+        let transient: Vec<bool> = a
+            .t_s
+            .iter()
+            .map(|t| whole[log.t_s.partition_point(|x| x < t).min(whole.len() - 1)])
+            .collect();
         let name = Path::new(p)
             .file_name()
             .map_or(p.clone(), |n| n.to_string_lossy().into());

@@ -193,6 +193,11 @@ fn parse_thinned<R: Read>(
             Problem::TooFewRows { rows },
         ));
     }
+    // The columns grew by doubling: hand back what they did not fill, so a log costs its
+    // values and nothing more while the diagnosis holds it.
+    for &(_, s) in &known {
+        log.column_mut(s).shrink_to_fit();
+    }
     Ok((log, rows))
 }
 

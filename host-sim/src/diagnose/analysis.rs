@@ -22,14 +22,14 @@ use super::diagnosis::Diagnosis;
 use super::displacement;
 use super::error::DiagnoseError;
 use super::facts::LogFacts;
-use super::findings::Analysis;
+use super::findings::{trace_step, traced_all, Analysis};
 use super::lines::window_lines;
 use super::mechanical::ShaftMotion;
 use super::mechanical_relation::mech;
 use super::predictions::{predict, Context, ModelValues};
 pub use super::relations::Precision;
 use super::relations::{Calibrations, Relations};
-use super::result::{assemble, extended_values};
+use super::result::{assemble, calibration_values, extended_values, fit_each, fit_of, Scored};
 use super::selection::select;
 use crate::bench_log::BenchLog;
 use plant_model::Rig;
@@ -275,6 +275,8 @@ pub fn analyse_reporting(
     let displacement = displacement::from_shaft(&cal.mechanical, cal.electrical.as_ref(), rig)
         .filter(|_| !facts.piston_moves);
     let (named, hydraulic_values) = select(&rel, &mut tested, rig, displacement);
+    // The line bases served the fits; the predictions do not read them.
+    rel.mechanical.forget_bases();
     // 6. Predictions and scores.
     let ctx = Context {
         log,
@@ -301,24 +303,37 @@ pub fn analyse_reporting(
     if let Some(v) = hydraulic_values {
         ext_values.hydraulic = v;
     }
+    // Beside the baseline's whole-log predictions (the evidence reads them), every other
+    // model's signals are predicted and scored one at a time.
     let baseline = predict(&ctx, &base_values);
-    let extended = if named.is_empty() {
-        baseline.clone()
+    let step = trace_step(facts.rows);
+    let val = facts.validation();
+    let base_fit = fit_of(log, &facts, &baseline, val.clone());
+    let (ext_fit, ext_trace) = if named.is_empty() {
+        (base_fit.clone(), traced_all(&baseline, step))
     } else {
-        predict(&ctx, &ext_values)
+        fit_each(&ctx, &ext_values, val, step)
     };
     let contributions = contributions(
         &ctx,
-        log,
-        &facts,
-        rig,
-        shaft,
+        (&facts, rig, shaft),
         (&tested, &named),
         &base_values,
-        (&baseline, &extended),
+        (&base_fit, &ext_fit),
     );
     progress.step("evidence");
-    let mut a = assemble(log, &facts, &rel, &cal, tested, named, baseline, extended);
+    // The evidence reads the log, its facts and the baseline's predictions only.
+    let calibration = calibration_values(&rel, &cal);
+    drop(rel);
+    drop(motion);
+    let scored = Scored {
+        baseline,
+        base_fit,
+        ext_fit,
+        ext_trace,
+        calibration,
+    };
+    let mut a = assemble(log, &facts, rig, &cal, tested, named, scored);
     a.contributions = contributions;
     progress.step("done");
     Ok(a)

@@ -6,42 +6,35 @@
 
 use super::angle_locked::ShaftConstants;
 use super::candidates::Tested;
+use super::diagnosis::Fit;
 use super::facts::LogFacts;
 use super::findings::Contributions;
-use super::predictions::{predict, Context, ModelValues};
-use super::result::{extended_values, fit_of};
-use crate::bench_log::BenchLog;
+use super::predictions::{Context, ModelValues};
+use super::result::{extended_values, fit_each};
 use plant_model::Rig;
-use std::collections::BTreeMap;
-
-/// Predictions by signal, whole log.
-type Predicted = BTreeMap<&'static str, Vec<f64>>;
 
 /// The contributions of `named` (indices into `tested`) from the calibrated `base`
-/// values and predictions `baseline` to the `extended` predictions.
-#[allow(clippy::too_many_arguments)]
+/// values, whose fit is `base_fit`, to the extended model, whose fit is `ext_fit`.
 pub(super) fn contributions(
     ctx: &Context<'_>,
-    log: &BenchLog,
-    facts: &LogFacts,
-    rig: &Rig,
-    shaft: ShaftConstants,
+    (facts, rig, shaft): (&LogFacts, &Rig, ShaftConstants),
     (tested, named): (&[Tested], &[usize]),
     base: &ModelValues,
-    (baseline, extended): (&Predicted, &Predicted),
+    (base_fit, ext_fit): (&Fit, &Fit),
 ) -> Contributions {
     let val = facts.validation();
-    let mut before = fit_of(log, facts, baseline, val.clone()).fit_percent_by_signal;
+    let mut before = base_fit.fit_percent_by_signal.clone();
     let mut values = base.clone();
     let mut out = Contributions::new();
     for (k, &i) in named.iter().enumerate() {
         values = extended_values(&values, &tested[i].extension, rig, shaft);
         let after = if k + 1 == named.len() {
-            fit_of(log, facts, extended, val.clone())
+            ext_fit.fit_percent_by_signal.clone()
         } else {
-            fit_of(log, facts, &predict(ctx, &values), val.clone())
-        }
-        .fit_percent_by_signal;
+            fit_each(ctx, &values, val.clone(), usize::MAX)
+                .0
+                .fit_percent_by_signal
+        };
         let gained = after
             .iter()
             .filter_map(|(s, f)| Some((s.clone(), f - before.get(s)?)))

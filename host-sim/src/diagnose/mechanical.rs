@@ -102,22 +102,28 @@ impl MechanicalParams {
 }
 
 /// Speed and acceleration from the angle (or the logged speed), computed once per log.
+///
+/// Every fit of the mechanical relation reads these at every row, so they are kept for
+/// the whole diagnosis: as single-precision values (a relative rounding of 6e-8, far below
+/// any sensor's noise), and the speed not at all when it is the logged one, so that the
+/// shaft's motion costs 28 bytes a row beside the log's own columns.
 #[derive(Clone, Debug)]
 pub struct ShaftMotion {
-    /// Speed. [rad/s]
-    pub speed_rad_s: Vec<f64>,
+    /// The speed the logged angle gives, when the angle is logged (otherwise the logged
+    /// speed is the shaft's). [rad/s]
+    speed_from_angle: Option<Vec<f32>>,
     /// Acceleration. [rad/s²]
-    pub accel_rad_s2: Vec<f64>,
+    accel_rad_s2: Vec<f32>,
     /// The q current's moving mean ([`MEAN_CURRENT_HALF_WIDTH_S`]), which scales the flux
     /// harmonics' torque line. [A]
-    pub iq_mean_a: Vec<f64>,
+    iq_mean_a: Vec<f32>,
     /// The Coulomb friction's sign, faded through zero speed: tanh(ω/[`COULOMB_FADE_RAD_S`])
     /// at the shaft's speed, computed once for every fit that scales it. [1]
-    pub coulomb_shape: Vec<f64>,
-    /// The unit phasors of the shaft angle θ and of the electrical angle p_n·θ at every row:
-    /// the cogging torque, the flux harmonics and the pump's ripple are evaluated at them in
-    /// every fit. [1]
-    pub rotation: Vec<[Phasor; 2]>,
+    coulomb_shape: Vec<f32>,
+    /// The unit phasors of the shaft angle θ and of the electrical angle p_n·θ at every row
+    /// as (cos θ, sin θ, cos p_n·θ, sin p_n·θ): the cogging torque, the flux harmonics and
+    /// the pump's ripple are evaluated at them in every fit. [1]
+    rotation: Vec<[f32; 4]>,
     /// How the acceleration was read: what it keeps of a line ([`ShaftMotion::accel_gain`]).
     pub accel_filter: AccelFilter,
 }
@@ -195,33 +201,77 @@ impl ShaftMotion {
             if facts.uniform {
                 let m = rows_spanning(SAVGOL_HALF_WIDTH_S, period, 1);
                 let accel = savgol_second_derivative(&facts.theta_rad, period, m);
-                (speed, accel, AccelFilter::SavitzkyGolay { half: m, period })
+                (
+                    Some(speed),
+                    accel,
+                    AccelFilter::SavitzkyGolay { half: m, period },
+                )
             } else {
                 let accel = central_rate(&log.t_s, &speed, h);
-                (speed, accel, central)
+                (Some(speed), accel, central)
             }
         } else {
             let accel = central_rate(&log.t_s, &log.speed_rad_s, h);
-            (log.speed_rad_s.clone(), accel, central)
+            (None, accel, central)
         };
         let coulomb_shape = speed
+            .as_deref()
+            .unwrap_or(&log.speed_rad_s)
             .iter()
-            .map(|w| (w / COULOMB_FADE_RAD_S).tanh())
+            .map(|w| (w / COULOMB_FADE_RAD_S).tanh() as f32)
             .collect();
         let pp = pole_pairs as f64;
         let rotation = facts
             .theta_rad
             .iter()
-            .map(|th| [Phasor::of(*th), Phasor::of(pp * th)])
+            .map(|th| {
+                let (m, e) = (Phasor::of(*th), Phasor::of(pp * th));
+                [m.cos as f32, m.sin as f32, e.cos as f32, e.sin as f32]
+            })
             .collect();
+        let single = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<f32>>();
         ShaftMotion {
             coulomb_shape,
             rotation,
-            speed_rad_s: speed,
-            accel_rad_s2: accel,
-            iq_mean_a: mean_current(&log.iq_a, facts.period_s),
+            speed_from_angle: speed.map(|s| single(&s)),
+            accel_rad_s2: single(&accel),
+            iq_mean_a: single(&mean_current(&log.iq_a, facts.period_s)),
             accel_filter,
         }
+    }
+
+    /// The shaft's speed at row `k` of `log` (the log the motion was read from). [rad/s]
+    #[inline]
+    pub fn speed_at(&self, log: &BenchLog, k: usize) -> f64 {
+        match &self.speed_from_angle {
+            Some(s) => s[k] as f64,
+            None => log.speed_rad_s[k],
+        }
+    }
+
+    /// The shaft's acceleration at row `k`. [rad/s²]
+    #[inline]
+    pub fn accel_at(&self, k: usize) -> f64 {
+        self.accel_rad_s2[k] as f64
+    }
+
+    /// The q current's moving mean at row `k`. [A]
+    #[inline]
+    pub fn iq_mean_at(&self, k: usize) -> f64 {
+        self.iq_mean_a[k] as f64
+    }
+
+    /// The Coulomb friction's faded sign at row `k`. [1]
+    #[inline]
+    pub fn coulomb_shape_at(&self, k: usize) -> f64 {
+        self.coulomb_shape[k] as f64
+    }
+
+    /// The unit phasors of the shaft angle and of the electrical angle at row `k`. [1]
+    #[inline]
+    pub fn rotation_at(&self, k: usize) -> [Phasor; 2] {
+        let [mc, ms, ec, es] = self.rotation[k].map(|x| x as f64);
+        [Phasor { cos: mc, sin: ms }, Phasor { cos: ec, sin: es }]
     }
 
     /// The fraction of a shaft oscillation's acceleration at angular frequency `w` that
@@ -326,7 +376,7 @@ impl Mechanics {
         t_em: f64,
     ) -> f64 {
         let theta = facts.theta_rad[k];
-        let w = motion.speed_rad_s[k];
+        let w = motion.speed_at(log, k);
         self.params
             .lines
             .iter()
@@ -352,18 +402,15 @@ impl Mechanics {
         out: &mut [f64],
     ) {
         let j = self.params.inertia_kg_m2;
-        let slow = &motion.iq_mean_a;
-        let rotation = &motion.rotation;
         let base = rows.start;
         for k in rows {
-            let w = motion.speed_rad_s[k];
-            let rot = rotation[k];
-            let shape = motion.coulomb_shape[k];
-            let need =
-                self.load_torque(log, facts, k, rot[0], w, shape) + j * motion.accel_rad_s2[k];
+            let w = motion.speed_at(log, k);
+            let rot = motion.rotation_at(k);
+            let shape = motion.coulomb_shape_at(k);
+            let need = self.load_torque(log, facts, k, rot[0], w, shape) + j * motion.accel_at(k);
             let (slope, rest) = self.torque_terms(log, rot, k);
             let slope = if slope.abs() > 1e-9 { slope } else { 1e-9 };
-            let t_mean = slope * slow[k] + rest;
+            let t_mean = slope * motion.iq_mean_at(k) + rest;
             out[k - base] = (need - rest + self.line_torque(log, facts, motion, k, t_mean)) / slope;
         }
     }
@@ -380,17 +427,15 @@ impl Mechanics {
     ) {
         let t = &log.t_s;
         let j = self.params.inertia_kg_m2.max(1e-12);
-        let slow = &motion.iq_mean_a;
-        let rotation = &motion.rotation;
         for win in windows {
-            let mut w = motion.speed_rad_s[win.start];
+            let mut w = motion.speed_at(log, win.start);
             out[win.start] = w;
             for k in win.start..win.end - 1 {
-                let rot = rotation[k];
+                let rot = motion.rotation_at(k);
                 let (slope, rest) = self.torque_terms(log, rot, k);
                 let t_em = slope * log.iq_a[k] + rest;
                 let drive = t_em
-                    - self.line_torque(log, facts, motion, k, slope * slow[k] + rest)
+                    - self.line_torque(log, facts, motion, k, slope * motion.iq_mean_at(k) + rest)
                     - self.load_torque(log, facts, k, rot[0], w, (w / COULOMB_FADE_RAD_S).tanh());
                 w += (t[k + 1] - t[k]) * drive / j;
                 out[k + 1] = w;

@@ -181,6 +181,14 @@ impl<'a> MechanicalRelation<'a> {
         }
     }
 
+    /// Lets go of the line bases the fits kept (a basis is some tens of bytes a row):
+    /// once the effects are selected, nothing reads them again.
+    pub fn forget_bases(&self) {
+        if let Ok(mut m) = self.bases.lock() {
+            *m = Default::default();
+        }
+    }
+
     fn basis(&self, rows: &Range<usize>) -> Option<DMatrix<f64>> {
         let key = (rows.start, rows.end);
         if let Some(b) = self.bases.lock().ok()?.get(&key) {

@@ -59,9 +59,22 @@ pub struct Context<'a> {
 
 /// Predicts every signal over the whole log.
 pub fn predict(c: &Context<'_>, m: &ModelValues) -> BTreeMap<&'static str, Vec<f64>> {
+    let mut out = BTreeMap::new();
+    predict_each(c, m, &mut |name, v| {
+        out.insert(name, v);
+    });
+    out
+}
+
+/// Predicts every signal over the whole log, handing each to `sink` as soon as it is
+/// made: a caller that only scores them holds one whole-log signal at a time.
+pub fn predict_each(
+    c: &Context<'_>,
+    m: &ModelValues,
+    sink: &mut dyn FnMut(&'static str, Vec<f64>),
+) {
     let n = c.facts.rows;
     let all = 0..n;
-    let mut out = BTreeMap::new();
     let mut p = vec![0.0; n];
     match (m.pressure_from_cylinder, c.cylinder, &m.cylinder) {
         (true, Some(rel), Some(v)) => rel.predict(v, all.clone(), &mut p),
@@ -71,24 +84,23 @@ pub fn predict(c: &Context<'_>, m: &ModelValues) -> BTreeMap<&'static str, Vec<f
             hyd.predict(&HydraulicInputs::of(c.log, c.facts), &w, &mut p);
         }
     }
-    out.insert("p_pa", p);
+    sink("p_pa", p);
     let mut params = mechanical_params(c.rig, &m.mechanical);
     params.lines = m.lines.clone();
     let mech = Mechanics::new(params);
     let mut speed = vec![0.0; n];
     let w = c.facts.windows(all.clone(), SPEED_WINDOW_S);
     mech.speed(c.log, c.facts, c.motion, &w, &mut speed);
-    out.insert("speed_rad_s", speed);
+    sink("speed_rad_s", speed);
     let mut iq = vec![0.0; n];
     mech.needed_current(c.log, c.facts, c.motion, all.clone(), &mut iq);
-    out.insert("iq_a", iq);
+    sink("iq_a", iq);
     if let (Some(rel), Some(v)) = (c.electrical, &m.electrical) {
         let (mut ud, mut uq) = (vec![0.0; n], vec![0.0; n]);
         rel.predict(v, all, &mut ud, &mut uq);
-        out.insert("ud_v", ud);
-        out.insert("uq_v", uq);
+        sink("ud_v", ud);
+        sink("uq_v", uq);
     }
-    out
 }
 
 /// Fit (%) and noise ratio of each predicted signal over `rows`.

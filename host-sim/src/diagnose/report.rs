@@ -23,16 +23,10 @@ pub const FILES: &[&str] = &[
     "residual_spectrum_*.png",
 ];
 
-/// Points per trace in a plot (the SVG stays small on long logs).
-const MAX_POINTS: usize = 4000;
-
+/// The points of a trace (the analysis keeps at most about
+/// [`super::findings::TRACE_POINTS`] rows of each, so the SVG stays small on long logs).
 fn decimated(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
-    let step = (t.len() / MAX_POINTS).max(1);
-    t.iter()
-        .zip(y)
-        .step_by(step)
-        .map(|(a, b)| (*a, *b))
-        .collect()
+    t.iter().zip(y).map(|(a, b)| (*a, *b)).collect()
 }
 
 /// Links a figure in the report (its PNG, readable in any viewer, and the SVG).

@@ -8,9 +8,9 @@ use super::candidates::{Extension, Tested};
 use super::decision::{threshold, why_not};
 use super::diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 use super::facts::LogFacts;
-use super::findings::Analysis;
+use super::findings::{trace_step, traced, traced_all, Analysis};
 use super::mechanical::{LineScale, TorqueLine};
-use super::predictions::{scores, ModelValues};
+use super::predictions::{predict_each, scores, Context, ModelValues};
 use super::relations::{Calibrations, Relations};
 use super::signatures::{residual_signature, Regressors, ResidualSignature};
 use super::spectrum::order_spectrum;
@@ -20,39 +20,57 @@ use plant_model::Rig;
 use std::collections::BTreeMap;
 use std::ops::Range;
 
-/// Stages 6 and 7: the scores on the validation segment, the evidence for the report and
-/// the contract's result.
-#[allow(clippy::too_many_arguments)]
+/// What the predictions left for the evidence: the baseline's whole-log predictions, both
+/// models' scores, the extended model's trace and the calibrated values by relation.
+pub(super) struct Scored {
+    /// Baseline predictions by signal, whole log.
+    pub baseline: BTreeMap<&'static str, Vec<f64>>,
+    /// The baseline's scores on the validation segment.
+    pub base_fit: Fit,
+    /// The extended model's scores on the validation segment.
+    pub ext_fit: Fit,
+    /// The extended model's predictions at the traced rows ([`trace_step`]).
+    pub ext_trace: BTreeMap<&'static str, Vec<f64>>,
+    /// Each relation's calibrated parameters by name.
+    pub calibration: BTreeMap<String, BTreeMap<String, f64>>,
+}
+
+/// Stage 7: the evidence for the report (signatures and order spectra of the baseline's
+/// residuals, the traces) and the contract's result.
 pub(super) fn assemble(
     log: &BenchLog,
     facts: &LogFacts,
-    rel: &Relations<'_>,
+    rig: &Rig,
     cal: &Calibrations,
     tested: Vec<Tested>,
     named: Vec<usize>,
-    baseline: BTreeMap<&'static str, Vec<f64>>,
-    extended: BTreeMap<&'static str, Vec<f64>>,
+    scored: Scored,
 ) -> Analysis {
-    let rig = rel.hydraulic.rig;
-    let val = facts.validation();
-    let base_fit = fit_of(log, facts, &baseline, val.clone());
-    let ext_fit = fit_of(log, facts, &extended, val.clone());
-    let measured: BTreeMap<&'static str, Vec<f64>> = baseline
-        .keys()
-        .filter_map(|k| {
-            let s = crate::bench_log::Signal::from_name(k)?;
-            Some((*k, log.column(s)?.to_vec()))
-        })
-        .collect();
-    let signatures = residual_signatures(log, facts, &measured, &baseline);
+    let Scored {
+        baseline,
+        base_fit,
+        ext_fit,
+        ext_trace,
+        calibration,
+    } = scored;
+    let signatures = residual_signatures(log, facts, &baseline);
     let spectra = ["p_pa", "speed_rad_s", "iq_a"]
         .iter()
         .filter_map(|name| {
-            let y = measured.get(name)?;
+            let y = log.column(crate::bench_log::Signal::from_name(name)?)?;
             let r = super::fit_score::residual(y, baseline.get(name)?);
             Some((*name, order_spectrum(&facts.theta_rad, &r)?))
         })
         .collect();
+    let step = trace_step(facts.rows);
+    let measured: BTreeMap<&'static str, Vec<f64>> = baseline
+        .keys()
+        .filter_map(|k| {
+            let s = crate::bench_log::Signal::from_name(k)?;
+            Some((*k, traced(log.column(s)?, step)))
+        })
+        .collect();
+    let baseline = traced_all(&baseline, step);
     let (hcal, mcal) = (&cal.hydraulic, &cal.mechanical);
     let causes = causes(&tested, &named, &calibration_summary(hcal, mcal, facts));
     let named_effects: Vec<String> = named
@@ -74,7 +92,7 @@ pub(super) fn assemble(
             rmse_reduction_percent: 100.0 * (1.0 - ext_fit.rmse_pa / base_fit.rmse_pa),
         },
         causes,
-        calibration: calibration_values(rel, cal),
+        calibration,
         extended: Extended {
             effects: named_effects,
             fit_percent: ext_fit.fit_percent,
@@ -86,10 +104,10 @@ pub(super) fn assemble(
     };
     Analysis {
         diagnosis,
-        t_s: t.clone(),
+        t_s: traced(t, step),
         measured,
         baseline,
-        extended,
+        extended: ext_trace,
         spectra,
         signatures,
         candidate_orders: candidate_orders(rig),
@@ -99,7 +117,7 @@ pub(super) fn assemble(
 }
 
 /// Each relation's calibrated parameters by name, for the JSON.
-fn calibration_values(
+pub(super) fn calibration_values(
     rel: &Relations<'_>,
     cal: &Calibrations,
 ) -> BTreeMap<String, BTreeMap<String, f64>> {
@@ -270,41 +288,65 @@ pub(super) fn fit_of(
     }
 }
 
-/// The time-domain signatures of every baseline residual.
+/// The contract's fit over `rows` of the model `values`, its signals predicted and scored
+/// one at a time, and each signal's trace at every `step`-th row.
+pub(super) fn fit_each(
+    ctx: &Context<'_>,
+    values: &ModelValues,
+    rows: Range<usize>,
+    step: usize,
+) -> (Fit, BTreeMap<&'static str, Vec<f64>>) {
+    let mut fit = Fit {
+        fit_percent: f64::NAN,
+        rmse_pa: f64::NAN,
+        fit_percent_by_signal: BTreeMap::new(),
+        noise_ratio_by_signal: BTreeMap::new(),
+    };
+    let mut trace = BTreeMap::new();
+    predict_each(ctx, values, &mut |name, v| {
+        let one = BTreeMap::from([(name, v)]);
+        let f = fit_of(ctx.log, ctx.facts, &one, rows.clone());
+        if name == "p_pa" {
+            (fit.fit_percent, fit.rmse_pa) = (f.fit_percent, f.rmse_pa);
+        }
+        fit.fit_percent_by_signal.extend(f.fit_percent_by_signal);
+        fit.noise_ratio_by_signal.extend(f.noise_ratio_by_signal);
+        trace.insert(name, traced(&one[name], step));
+    });
+    (fit, trace)
+}
+
+/// The time-domain signatures of every baseline residual, the model's own predictions of
+/// the other signals as regressors where it made them.
 fn residual_signatures(
     log: &BenchLog,
     facts: &LogFacts,
-    measured: &BTreeMap<&'static str, Vec<f64>>,
     baseline: &BTreeMap<&'static str, Vec<f64>>,
 ) -> Vec<ResidualSignature> {
-    let point = |name: &str, logged: &'static str| -> Vec<f64> {
-        baseline
-            .get(name)
-            .cloned()
-            .unwrap_or_else(|| measured.get(logged).cloned().unwrap_or_default())
-    };
-    let speed = point("speed_rad_s", "speed_rad_s");
-    let p = point("p_pa", "p_pa");
-    let iq = point("iq_a", "iq_a");
     let with = Regressors {
-        speed_rad_s: if speed.len() == facts.rows {
-            &speed
-        } else {
-            &log.speed_rad_s
-        },
-        p_pa: if p.len() == facts.rows { &p } else { &log.p_pa },
-        iq_a: if iq.len() == facts.rows {
-            &iq
-        } else {
-            &log.iq_a
-        },
+        speed_rad_s: predicted_or(baseline, "speed_rad_s", &log.speed_rad_s),
+        p_pa: predicted_or(baseline, "p_pa", &log.p_pa),
+        iq_a: predicted_or(baseline, "iq_a", &log.iq_a),
     };
-    measured
+    baseline
         .iter()
-        .filter_map(|(name, y)| {
-            residual_signature(name, facts.period_s, y, baseline.get(name)?, &with)
+        .filter_map(|(name, b)| {
+            let y = log.column(crate::bench_log::Signal::from_name(name)?)?;
+            residual_signature(name, facts.period_s, y, b, &with)
         })
         .collect()
+}
+
+/// The whole-log prediction of `name` in `predicted`, or `logged` when there is none.
+fn predicted_or<'a>(
+    predicted: &'a BTreeMap<&'static str, Vec<f64>>,
+    name: &str,
+    logged: &'a [f64],
+) -> &'a [f64] {
+    match predicted.get(name) {
+        Some(v) if v.len() == logged.len() => v,
+        _ => logged,
+    }
 }
 
 /// The angle-locked orders each effect would show at.

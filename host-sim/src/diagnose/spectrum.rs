@@ -52,15 +52,16 @@ pub fn order_spectrum(theta: &[f64], residual: &[f64]) -> Option<OrderSpectrum> 
     }
     let (theta, residual) = (&theta[..n], &residual[..n]);
     let sign = if theta[n - 1] >= theta[0] { 1.0 } else { -1.0 };
-    let a: Vec<f64> = theta.iter().map(|t| sign * (t - theta[0])).collect();
+    // The angle turned since the first row, forward (read row by row, not copied).
+    let a = |i: usize| sign * (theta[i] - theta[0]);
     let mut peak = f64::NEG_INFINITY;
-    for &x in &a {
+    for x in (0..n).map(a) {
         if x < peak - 0.2 * PI {
             return None;
         }
         peak = peak.max(x);
     }
-    let revolutions = (a[n - 1] / (2.0 * PI)).floor() as usize;
+    let revolutions = (a(n - 1) / (2.0 * PI)).floor() as usize;
     if revolutions < 2 {
         return None;
     }
@@ -70,10 +71,10 @@ pub fn order_spectrum(theta: &[f64], residual: &[f64]) -> Option<OrderSpectrum> 
     for i in 0..m {
         let target = 2.0 * PI * i as f64 / SAMPLES_PER_REV as f64;
         // The angle is monotonic up to small reversals: advance to the bracketing pair.
-        while j + 2 < n && a[j + 1] < target {
+        while j + 2 < n && a(j + 1) < target {
             j += 1;
         }
-        let (a0, a1) = (a[j], a[j + 1]);
+        let (a0, a1) = (a(j), a(j + 1));
         let f = if a1 > a0 {
             ((target - a0) / (a1 - a0)).clamp(0.0, 1.0)
         } else {
