@@ -93,14 +93,14 @@ fn significant(causes: Vec<Cause>) -> Vec<Cause> {
 /// half, one list per diagnosis. The whole log's diagnosis must succeed; the second half's
 /// may not (too short a log for it), and then adds nothing.
 pub fn causes_of(log: &BenchLog, rig: &Rig) -> Result<Vec<Vec<Cause>>, CliError> {
-    let half = log.tail(log.len() / 2);
     // The table is built from the fitted parameters themselves: the fits run to the end.
+    // One diagnosis after the other (each runs its relations in parallel): side by side
+    // they would hold the log, its half and both diagnoses' rows at once.
     let learn = |l: &BenchLog| diagnose_to(l, rig, Precision::Learning);
-    let (whole, second) = rayon::join(|| learn(log), || learn(&half));
-    let whole =
-        whole.map_err(|e| CliError::Failed(format!("the diagnosis of the log failed: {e}")))?;
+    let whole = learn(log)
+        .map_err(|e| CliError::Failed(format!("the diagnosis of the log failed: {e}")))?;
     let mut out = vec![significant(whole.causes)];
-    if let Ok(d) = second {
+    if let Ok(d) = learn(&log.tail(log.len() / 2)) {
         out.push(significant(d.causes));
     }
     Ok(out)
