@@ -71,29 +71,66 @@ fn can() -> Result<()> {
 }
 
 fn test() -> Result<()> {
-    ensure_target()?;
-    setup::tools()?;
-    let python = setup::python()?;
-    run("format", cargo().args(["fmt", "--all", "--", "--check"]))?;
-    run(
-        "lint",
-        cargo().args([
-            "clippy",
-            "--workspace",
-            "--all-targets",
-            "--",
-            "-D",
-            "warnings",
-        ]),
-    )?;
-    rooms::rooms(&[])?;
-    run("host tests", cargo().args(["test", "--workspace"]))?;
-    fleet_check::check(&python)?;
-    let text = dbc::generate(dbc::DEFAULT_NODE)?;
-    dbc::check_in_sync(&text, &root().join(dbc::FILE))?;
-    can_check::check(&python)?;
-    firmware()?;
-    pil::pil()?;
+    let mut times = StepTimes::default();
+    times.step("setup", || {
+        ensure_target()?;
+        setup::tools()
+    })?;
+    let python = times.step("python", setup::python)?;
+    times.step("format", || {
+        run("format", cargo().args(["fmt", "--all", "--", "--check"]))
+    })?;
+    times.step("lint", || {
+        run(
+            "lint",
+            cargo().args([
+                "clippy",
+                "--workspace",
+                "--all-targets",
+                "--",
+                "-D",
+                "warnings",
+            ]),
+        )
+    })?;
+    times.step("rooms", || rooms::rooms(&[]))?;
+    times.step("host tests", || {
+        run("host tests", cargo().args(["test", "--workspace"]))
+    })?;
+    times.step("fleet", || fleet_check::check(&python))?;
+    times.step("can", || {
+        let text = dbc::generate(dbc::DEFAULT_NODE)?;
+        dbc::check_in_sync(&text, &root().join(dbc::FILE))?;
+        can_check::check(&python)
+    })?;
+    times.step("firmware", || firmware().map(|_| ()))?;
+    times.step("pil", pil::pil)?;
+    eprintln!("\nxtask: step times\n{times}");
     eprintln!("\nxtask: all checks passed");
     Ok(())
+}
+
+/// How long each step of `cargo xtask test` took (wall clock), printed at the end so a CI
+/// log shows where its time goes.
+#[derive(Default)]
+struct StepTimes(Vec<(&'static str, std::time::Duration)>);
+
+impl StepTimes {
+    /// Runs `f` as the step `name`, timing it.
+    fn step<T>(&mut self, name: &'static str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+        let start = std::time::Instant::now();
+        let out = f();
+        self.0.push((name, start.elapsed()));
+        out
+    }
+}
+
+impl std::fmt::Display for StepTimes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let total: std::time::Duration = self.0.iter().map(|(_, d)| *d).sum();
+        for (name, d) in &self.0 {
+            writeln!(f, "  {name:<12} {:>7.1} s", d.as_secs_f64())?;
+        }
+        write!(f, "  {:<12} {:>7.1} s", "all", total.as_secs_f64())
+    }
 }
