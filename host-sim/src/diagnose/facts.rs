@@ -79,8 +79,9 @@ pub struct LogFacts {
     pub theta_rad: Vec<f64>,
     /// Whether `theta_rad` was logged (else integrated, so its absolute phase is unknown).
     pub angle_logged: bool,
-    /// Low-side (port B) pressure: logged, or the rig's fill pressure. [Pa]
-    pub p_low_pa: Vec<f64>,
+    /// The rig's fill pressure, the low side's (port B) where the log does not hold it
+    /// ([`LogFacts::p_low`]). [Pa]
+    pub fill_low_pa: f64,
     /// The fill (boost) level the ports' check valves hold them at, as the port transducers
     /// read it: the median over the rows of the lower of the two port pressures (the
     /// unloaded port sits there), or the rig's fill pressure less the check valve's
@@ -110,7 +111,42 @@ pub struct LogFacts {
     pub steady: Vec<SteadyWindow>,
 }
 
+/// The low side's (port B) pressure row by row: the logged column, or one level throughout
+/// (read where it is needed, never copied). [Pa]
+#[derive(Clone, Copy, Debug)]
+pub enum LowSide<'a> {
+    /// The log's `p_low_pa`.
+    Logged(&'a [f64]),
+    /// The same pressure at every row.
+    Level(f64),
+}
+
+impl<'a> LowSide<'a> {
+    /// The log's low side, or `level` where it is not logged.
+    pub fn of(log: &'a BenchLog, level: f64) -> LowSide<'a> {
+        match log.p_low_pa.as_deref() {
+            Some(p) => LowSide::Logged(p),
+            None => LowSide::Level(level),
+        }
+    }
+
+    /// The pressure at row `k`. [Pa]
+    #[inline]
+    pub fn at(&self, k: usize) -> f64 {
+        match self {
+            LowSide::Logged(p) => p[k],
+            LowSide::Level(p) => *p,
+        }
+    }
+}
+
 impl LogFacts {
+    /// The low side's pressure of `log` (the log these facts are of): logged, or the rig's
+    /// fill pressure. [Pa]
+    pub fn p_low<'a>(&self, log: &'a BenchLog) -> LowSide<'a> {
+        LowSide::of(log, self.fill_low_pa)
+    }
+
     /// The facts of a checked `log` (at least a few rows, time increasing) on `rig`.
     pub fn of(log: &BenchLog, rig: &Rig) -> LogFacts {
         let rows = log.len();
@@ -123,10 +159,8 @@ impl LogFacts {
             Some(th) => (unwrap_angle(th), true),
             None => (integrated_angle(t, &log.speed_rad_s), false),
         };
-        let p_low_pa = log
-            .p_low_pa
-            .clone()
-            .unwrap_or_else(|| vec![rig.fill.pressure_pa; rows]);
+        let fill_low_pa = rig.fill.pressure_pa;
+        let p_low = LowSide::of(log, fill_low_pa);
         let fill_pa = match log.p_low_pa.as_deref() {
             Some(pl) => {
                 let mut lower: Vec<f64> = log.p_pa.iter().zip(pl).map(|(a, b)| a.min(*b)).collect();
@@ -147,7 +181,7 @@ impl LogFacts {
             log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
                 savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
             });
-        let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, &p_low_pa, rig);
+        let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, p_low, rig);
         let split = segment_split(t, &theta_rad, period_s, rig);
         let start = t
             .partition_point(|x| *x < t[0] + START_SKIP_S)
@@ -175,7 +209,7 @@ impl LogFacts {
             uniform,
             theta_rad,
             angle_logged,
-            p_low_pa,
+            fill_low_pa,
             fill_pa,
             piston_moves,
             x_smooth_m,
@@ -443,16 +477,16 @@ fn steady_windows(t: &[f64], theta: &[f64], period_s: f64) -> Vec<SteadyWindow> 
 /// oil's compression over the logged pressure range, the whole absorber shell if the
 /// pressure rose above its precharge, and twice the rig's leakage — plus a cubic
 /// centimetre. A blocked cylinder's pump only replaces leakage and compression. [m³]
-pub fn unseen_piston_motion(log: &BenchLog, p_low_pa: &[f64], rig: &Rig) -> bool {
+pub fn unseen_piston_motion(log: &BenchLog, p_low: LowSide<'_>, rig: &Rig) -> bool {
     let d_per_rad = rig.pump.displacement_m3_per_rev / (2.0 * PI);
     let leakage = rig.pump.internal_leakage_m3_s_pa
         + rig.pump.external_leakage_m3_s_pa
         + rig.cylinder.internal_leakage_m3_s_pa;
     let (mut displaced, mut leaked) = (0.0, 0.0);
-    for (k, p_low) in p_low_pa.iter().enumerate().skip(1) {
+    for k in 1..log.len() {
         let dt = log.t_s[k] - log.t_s[k - 1];
         displaced += d_per_rad * log.speed_rad_s[k].abs() * dt;
-        leaked += 2.0 * leakage * (log.p_pa[k] - p_low).abs() * dt;
+        leaked += 2.0 * leakage * (log.p_pa[k] - p_low.at(k)).abs() * dt;
     }
     let (lo, hi) = log
         .p_pa

@@ -29,7 +29,7 @@
 //! linear in it: two runs give the sensitivity); the absorber in equilibrium with it and
 //! filling at the slope.
 
-use crate::diagnose::facts::{rows_spanning, LogFacts};
+use crate::diagnose::facts::{rows_spanning, LogFacts, LowSide};
 use plant_model::accumulator::{GasCharge, ATMOSPHERE_PA};
 use plant_model::pump::Pump;
 use plant_model::Rig;
@@ -127,7 +127,7 @@ pub struct HydraulicInputs<'a> {
     /// Shaft angle, unwrapped. [rad]
     pub theta_rad: &'a [f64],
     /// Low-side pressure. [Pa]
-    pub p_low_pa: &'a [f64],
+    pub p_low_pa: LowSide<'a>,
     /// Piston position, when it moves. [m]
     pub x_m: Option<&'a [f64]>,
     /// Measured pressure (window starts). [Pa]
@@ -144,7 +144,7 @@ impl<'a> HydraulicInputs<'a> {
         HydraulicInputs {
             t_s: &log.t_s,
             theta_rad: &facts.theta_rad,
-            p_low_pa: &facts.p_low_pa,
+            p_low_pa: facts.p_low(log),
             x_m: facts.x_smooth_m.as_deref(),
             p_pa: &log.p_pa,
             start_rows: rows_spanning(START_S, facts.period_s, 2),
@@ -314,7 +314,7 @@ impl Hydraulics {
                 Some(xm) => (xm[k], xm[next] - xm[k]),
                 None => (0.0, 0.0),
             };
-            let p_low = x.p_low_pa[k];
+            let p_low = x.p_low_pa.at(k);
             // Flow into the node over a substep: pump minus piston, as a mean [m³/s]; and
             // the oil's capacitance at the piston's position [m³/Pa]. Both are the row's
             // own unless the pump ripples or the piston moves.
@@ -424,7 +424,7 @@ mod tests {
         let inputs = HydraulicInputs {
             t_s: t,
             theta_rad: th,
-            p_low_pa: &pl,
+            p_low_pa: LowSide::Logged(&pl),
             x_m: None,
             p_pa: &p,
             start_rows: 10,

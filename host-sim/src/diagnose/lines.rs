@@ -318,7 +318,10 @@ pub fn window_lines(
                 window: w.clone(),
                 iq_mean_a: mean(&log.iq_a),
                 id_mean_a: mean(&log.id_a),
-                dp_mean_pa: mean(&log.p_pa) - mean(&facts.p_low_pa),
+                dp_mean_pa: mean(&log.p_pa) - {
+                    let low = facts.p_low(log);
+                    rows.clone().map(|k| low.at(k)).sum::<f64>() / rows.len() as f64
+                },
                 orders: lines,
             })
         })

@@ -359,7 +359,7 @@ impl Mechanics {
             1.0
         };
         self.pump
-            .load_torque(log.p_pa[k], facts.p_low_pa[k], factor)
+            .load_torque(log.p_pa[k], facts.p_low(log).at(k), factor)
             + m.viscous_nm_s * speed
             + m.coulomb_nm * shape
     }
@@ -384,7 +384,7 @@ impl Mechanics {
                 let x = match l.scale {
                     LineScale::Constant => 1.0,
                     LineScale::Electromagnetic => t_em,
-                    LineScale::PressureDifference(f) => f * (log.p_pa[k] - facts.p_low_pa[k]),
+                    LineScale::PressureDifference(f) => f * (log.p_pa[k] - facts.p_low(log).at(k)),
                 };
                 let kept = motion.accel_gain(l.order as f64 * w).clamp(0.0, 1.0);
                 kept * x * (l.amplitude * Complex64::from_polar(1.0, l.order as f64 * theta)).re

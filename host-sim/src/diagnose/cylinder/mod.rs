@@ -251,8 +251,8 @@ impl<'a> CylinderRelation<'a> {
     /// relation's pressure shift `shift` (the value of [`ix::ZERO`] or [`ix::LOW_SIDE`]):
     /// the logged low side plus the port transducer's zero, or the shift itself. [Pa]
     fn low_side(&self, shift: f64, k: usize) -> f64 {
-        match self.log.p_low_pa {
-            Some(_) => self.facts.p_low_pa[k] + shift,
+        match &self.log.p_low_pa {
+            Some(p) => p[k] + shift,
             None => shift,
         }
     }
