@@ -98,14 +98,7 @@ fn json_rows(path: &Path) -> Result<Vec<Value>> {
 /// Runs the check with the Python interpreter `python`.
 pub fn check(python: &Path) -> Result<()> {
     let root = crate::workspace::root();
-    // `eha` as the host tests build it (their integration tests run it): after them nothing
-    // is rebuilt, where `cargo build -p host-sim` would resolve the dependencies' features
-    // without the workspace's dev-dependencies and compile them all again.
-    crate::workspace::run(
-        "eha for the fleet check",
-        crate::workspace::cargo().args(["test", "--workspace", "--no-run"]),
-    )?;
-    let eha = crate::workspace::target_dir().join("debug").join("eha");
+    let eha = crate::workspace::eha_binary("eha for the fleet check")?;
     let base = crate::workspace::target_dir().join("fleet-check");
     let _ = fs::remove_dir_all(&base);
     let logs = base.join("logs");

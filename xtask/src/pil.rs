@@ -87,22 +87,22 @@ pub fn pil() -> Result<()> {
         );
     }
 
+    let eha_bin = crate::workspace::eha_binary("eha for the PIL comparison")?;
     let pil_csv = out_dir.join("pil.csv");
     let host_csv = out_dir.join("host.csv");
     crate::workspace::run(
         "eha ingest (PIL telemetry)",
-        eha().args([
+        eha(&eha_bin).args([
             "ingest",
             path_str(&defmt_log)?,
             "--out",
             path_str(&pil_csv)?,
         ]),
     )?;
-    let eha_bin = crate::workspace::target_dir().join("debug").join("eha");
     crate::watch_check::check(&eha_bin, &defmt_log, &pil_csv, &out_dir)?;
     crate::workspace::run(
         "eha simulate (same scenario on the host)",
-        eha().args([
+        eha(&eha_bin).args([
             "simulate",
             "--scenario",
             SCENARIO,
@@ -216,19 +216,9 @@ fn firmware_stack_bytes() -> Option<u64> {
     symbol("_stack_start")?.checked_sub(symbol("_stack_end")?)
 }
 
-/// `eha` from the workspace (the host tests have already built it).
-fn eha() -> Command {
-    let mut c = crate::workspace::cargo();
-    c.args([
-        "run",
-        "--quiet",
-        "--package",
-        "host-sim",
-        "--bin",
-        "eha",
-        "--",
-    ]);
-    c
+/// `eha` from the workspace, as the host tests build it ([`crate::workspace::eha_binary`]).
+fn eha(bin: &Path) -> Command {
+    Command::new(bin)
 }
 
 fn path_str(p: &Path) -> Result<&str> {

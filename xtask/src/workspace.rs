@@ -38,3 +38,12 @@ pub fn run(step: &str, cmd: &mut Command) -> Result<()> {
     }
     Ok(())
 }
+
+/// `eha` as the host tests build it (their integration tests run it), built if needed:
+/// right after `cargo test --workspace` nothing is rebuilt, where `cargo build -p host-sim`
+/// would resolve the dependencies' features without the workspace's dev-dependencies and
+/// compile them all again.
+pub fn eha_binary(step: &str) -> Result<PathBuf> {
+    run(step, cargo().args(["test", "--workspace", "--no-run"]))?;
+    Ok(target_dir().join("debug").join("eha"))
+}
