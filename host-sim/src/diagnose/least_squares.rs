@@ -311,20 +311,29 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
             .ok()
             .and_then(|l| l.as_ref().filter(|(v, _)| *v == v0).map(|(_, r)| r.clone()));
         let r0 = cached.unwrap_or_else(|| self.full_residuals(&v0));
+        let m = r0.len();
+        // Each column's difference quotient computed in the residuals' own buffer, the
+        // columns moved into the matrix's storage: one whole-fit vector a column.
         let columns: Vec<Vec<f64>> = (0..v0.len())
             .into_par_iter()
             .map(|k| {
                 let h = 1e-4 * (1.0 + v0[k].abs());
                 let mut v = v0.clone();
                 v[k] += h;
-                let r = self.full_residuals(&v);
-                r.iter().zip(&r0).map(|(a, b)| (a - b) / h).collect()
+                let mut r = self.full_residuals(&v);
+                let n = r.len().min(m);
+                r.resize(m, 0.0);
+                for (a, b) in r[..n].iter_mut().zip(&r0) {
+                    *a = (*a - b) / h;
+                }
+                r
             })
             .collect();
-        let m = r0.len();
-        Some(DMatrix::from_fn(m, v0.len(), |i, k| {
-            columns[k].get(i).copied().unwrap_or(0.0)
-        }))
+        let mut storage = Vec::with_capacity(m * v0.len());
+        for c in columns {
+            storage.extend_from_slice(&c);
+        }
+        Some(DMatrix::from_vec(m, v0.len(), storage))
     }
 }
 
