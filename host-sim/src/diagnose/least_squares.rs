@@ -311,28 +311,26 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
             .ok()
             .and_then(|l| l.as_ref().filter(|(v, _)| *v == v0).map(|(_, r)| r.clone()));
         let r0 = cached.unwrap_or_else(|| self.full_residuals(&v0));
-        let m = r0.len();
-        // Each column's difference quotient computed in the residuals' own buffer, the
-        // columns moved into the matrix's storage: one whole-fit vector a column.
-        let columns: Vec<Vec<f64>> = (0..v0.len())
-            .into_par_iter()
-            .map(|k| {
+        let (m, n) = (r0.len(), v0.len());
+        if m == 0 {
+            return Some(DMatrix::zeros(0, n));
+        }
+        // Each column's difference quotient written straight into the matrix's storage
+        // (column-major), the columns in parallel: no second copy of the Jacobian. Rows a
+        // shorter residual vector lacks stay zero.
+        let mut storage = vec![0.0; m * n];
+        storage
+            .par_chunks_mut(m)
+            .enumerate()
+            .for_each(|(k, column)| {
                 let h = 1e-4 * (1.0 + v0[k].abs());
                 let mut v = v0.clone();
                 v[k] += h;
-                let mut r = self.full_residuals(&v);
-                let n = r.len().min(m);
-                r.resize(m, 0.0);
-                for (a, b) in r[..n].iter_mut().zip(&r0) {
-                    *a = (*a - b) / h;
+                let r = self.full_residuals(&v);
+                for (c, (a, b)) in column.iter_mut().zip(r.iter().zip(&r0)) {
+                    *c = (a - b) / h;
                 }
-                r
-            })
-            .collect();
-        let mut storage = Vec::with_capacity(m * v0.len());
-        for c in columns {
-            storage.extend_from_slice(&c);
-        }
+            });
         Some(DMatrix::from_vec(m, v0.len(), storage))
     }
 }
