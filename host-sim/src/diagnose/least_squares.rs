@@ -305,22 +305,21 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
         let v0: Vec<f64> = self.v.iter().copied().collect();
+        // The residuals just computed at this point, taken (not copied): the optimiser asks
+        // one Jacobian a point.
         let cached = self
             .last
             .lock()
             .ok()
-            .and_then(|l| l.as_ref().filter(|(v, _)| *v == v0).map(|(_, r)| r.clone()));
+            .and_then(|mut l| l.take().filter(|(v, _)| *v == v0).map(|(_, r)| r));
         let r0 = cached.unwrap_or_else(|| self.full_residuals(&v0));
         let (m, n) = (r0.len(), v0.len());
-        if m == 0 {
-            return Some(DMatrix::zeros(0, n));
-        }
         // Each column's difference quotient written straight into the matrix's storage
         // (column-major), the columns in parallel: no second copy of the Jacobian. Rows a
         // shorter residual vector lacks stay zero.
         let mut storage = vec![0.0; m * n];
         storage
-            .par_chunks_mut(m)
+            .par_chunks_mut(m.max(1))
             .enumerate()
             .for_each(|(k, column)| {
                 let h = 1e-4 * (1.0 + v0[k].abs());
@@ -331,7 +330,7 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
                     *c = (a - b) / h;
                 }
             });
-        Some(DMatrix::from_vec(m, v0.len(), storage))
+        Some(DMatrix::from_vec(m, n, storage))
     }
 }
 
