@@ -9,10 +9,12 @@
 //! deviations span the band, as an extra residual: the fit stays in the band unless the
 //! data insist, and how much they insist is the likelihood ratio the decision reads.
 //!
-//! The Jacobian is taken by forward differences in `v`, its columns in parallel.
+//! A parameter the data press onto a hard bound is held there while the others are
+//! searched ([`crate::diagnose::active_set`]), instead of creeping towards the transform's
+//! flat end.
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use crate::diagnose::active_set::{minimise, Minimum};
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 /// Offset of the optimiser's coordinates from the sine transform's: MINPACK sizes its first
@@ -124,12 +126,12 @@ impl ParamSpec {
         (0.5 * (lo + hi), 0.5 * (hi - lo))
     }
 
-    fn u_of_v(&self, v: f64) -> f64 {
+    pub(crate) fn u_of_v(&self, v: f64) -> f64 {
         let (c, h) = self.centre();
         c + h * (v - V_OFFSET).sin()
     }
 
-    fn v_of_u(&self, u: f64) -> f64 {
+    pub(crate) fn v_of_u(&self, u: f64) -> f64 {
         let (c, h) = self.centre();
         if h <= 0.0 {
             return V_OFFSET;
@@ -244,96 +246,6 @@ impl<F: Fn(&[f64]) -> Vec<f64> + Sync> Model for F {
     }
 }
 
-struct Problem<'a, M: Model> {
-    model: &'a M,
-    specs: &'a [ParamSpec],
-    v: DVector<f64>,
-    evaluations: std::sync::atomic::AtomicUsize,
-    /// The residuals last computed by `residuals` and the point they were computed at:
-    /// the optimiser asks for the Jacobian at the point whose residuals it just had.
-    last: std::sync::Mutex<Option<(Vec<f64>, Vec<f64>)>>,
-}
-
-impl<M: Model> Problem<'_, M> {
-    fn values_at(&self, v: &[f64]) -> Vec<f64> {
-        self.specs
-            .iter()
-            .zip(v)
-            .map(|(s, v)| s.value(s.u_of_v(*v)))
-            .collect()
-    }
-
-    fn full_residuals(&self, v: &[f64]) -> Vec<f64> {
-        self.evaluations
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let mut r = self.model.residuals(&self.values_at(v));
-        for r in r.iter_mut() {
-            if !r.is_finite() {
-                *r = 1e6;
-            }
-        }
-        for (s, v) in self.specs.iter().zip(v) {
-            if let Some((m, sd)) = s.prior {
-                r.push((s.u_of_v(*v) - m) / sd);
-            }
-        }
-        r
-    }
-}
-
-impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.v.copy_from(x);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.v.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let v: Vec<f64> = self.v.iter().copied().collect();
-        let r = self.full_residuals(&v);
-        if let Ok(mut last) = self.last.lock() {
-            *last = Some((v, r.clone()));
-        }
-        Some(DVector::from_vec(r))
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let v0: Vec<f64> = self.v.iter().copied().collect();
-        // The residuals just computed at this point, taken (not copied): the optimiser asks
-        // one Jacobian a point.
-        let cached = self
-            .last
-            .lock()
-            .ok()
-            .and_then(|mut l| l.take().filter(|(v, _)| *v == v0).map(|(_, r)| r));
-        let r0 = cached.unwrap_or_else(|| self.full_residuals(&v0));
-        let (m, n) = (r0.len(), v0.len());
-        // Each column's difference quotient written straight into the matrix's storage
-        // (column-major), the columns in parallel: no second copy of the Jacobian. Rows a
-        // shorter residual vector lacks stay zero.
-        let mut storage = vec![0.0; m * n];
-        storage
-            .par_chunks_mut(m.max(1))
-            .enumerate()
-            .for_each(|(k, column)| {
-                let h = 1e-4 * (1.0 + v0[k].abs());
-                let mut v = v0.clone();
-                v[k] += h;
-                let r = self.full_residuals(&v);
-                for (c, (a, b)) in column.iter_mut().zip(r.iter().zip(&r0)) {
-                    *c = (a - b) / h;
-                }
-            });
-        Some(DMatrix::from_vec(m, n, storage))
-    }
-}
-
 /// Iterations the optimiser may spend per parameter (its `patience`). The hydraulic
 /// relation's tolerance bands leave flat curved valleys (transducer gain against
 /// displacement and volume) along which the optimiser creeps by hundredths of a noise unit
@@ -345,11 +257,6 @@ pub const PATIENCE: usize = 10;
 /// learned from them): the creep along the valleys is followed to its end.
 pub const THOROUGH_PATIENCE: usize = 25;
 
-/// Relative reduction of the objective (and of the step) below which the optimiser stops:
-/// on objectives of 10⁴–10⁵ noise units a millionth is a tenth of a unit, far below the
-/// χ² thresholds (15–18) the decision compares differences with. [1]
-const FTOL: f64 = 1e-6;
-
 /// Fits `specs` to `model` from their starts.
 pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
     fit_with_patience(model, specs, PATIENCE)
@@ -359,33 +266,15 @@ pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
 pub fn fit_with_patience<M: Model>(model: &M, specs: &[ParamSpec], patience: usize) -> Fitted {
     // A start on a bound would freeze the search there (the sine transform is flat at its
     // ends): every start at least 1 % of the range inside.
-    let v0 = DVector::from_iterator(
-        specs.len(),
-        specs.iter().map(|s| {
+    let u0: Vec<f64> = specs
+        .iter()
+        .map(|s| {
             let (lo, hi) = s.u_bounds;
             let margin = 0.01 * (hi - lo);
-            s.v_of_u(s.start.clamp(lo + margin, hi - margin))
-        }),
-    );
-    let problem = Problem {
-        model,
-        specs,
-        v: v0,
-        evaluations: std::sync::atomic::AtomicUsize::new(0),
-        last: std::sync::Mutex::new(None),
-    };
-    let (problem, _report) = if specs.is_empty() {
-        (problem, None)
-    } else {
-        let (p, r) = LevenbergMarquardt::<f64>::new()
-            .with_patience(patience)
-            .with_ftol(FTOL)
-            .with_xtol(FTOL)
-            .minimize(problem);
-        (p, Some(r))
-    };
-    let v: Vec<f64> = problem.v.iter().copied().collect();
-    let u: Vec<f64> = specs.iter().zip(&v).map(|(s, v)| s.u_of_v(*v)).collect();
+            s.start.clamp(lo + margin, hi - margin)
+        })
+        .collect();
+    let Minimum { u, evaluations } = minimise(model, specs, u0, patience);
     let values: Vec<f64> = specs.iter().zip(&u).map(|(s, u)| s.value(*u)).collect();
     let data = model.residuals(&values);
     let data_sse = data
@@ -399,10 +288,7 @@ pub fn fit_with_patience<M: Model>(model: &M, specs: &[ParamSpec], patience: usi
         .sum();
     let covariance_u = covariance(model, specs, &u, &data);
     Fitted {
-        evaluations: problem
-            .evaluations
-            .load(std::sync::atomic::Ordering::Relaxed)
-            + 1,
+        evaluations: evaluations + 1,
         u,
         values,
         data_sse,

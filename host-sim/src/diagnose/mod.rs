@@ -25,6 +25,7 @@
 //! - [`findings`]: everything one run computed; [`diagnosis`]: the contract's JSON;
 //!   [`report`]: the markdown report; [`command`]: the CLI.
 
+pub mod active_set;
 pub mod ambiguity;
 pub mod analysis;
 pub mod angle_locked;
