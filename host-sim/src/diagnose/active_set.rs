@@ -18,12 +18,25 @@
 //!
 //! The Jacobian is taken by forward differences in v, its columns in parallel.
 
-use crate::diagnose::least_squares::{Model, ParamSpec};
+use crate::diagnose::param_spec::ParamSpec;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
+
+/// Residuals of a model at parameter values: data rows already divided by their noise
+/// scale, so each is about unit variance for a right model.
+pub trait Model: Sync {
+    /// The residuals at `values` (one per parameter spec, in order).
+    fn residuals(&self, values: &[f64]) -> Vec<f64>;
+}
+
+impl<F: Fn(&[f64]) -> Vec<f64> + Sync> Model for F {
+    fn residuals(&self, values: &[f64]) -> Vec<f64> {
+        self(values)
+    }
+}
 
 /// Share of a parameter's range from either end within which it is taken to rest on that
 /// end: a millionth, where the transform's slope is 0.2 % of its greatest and the
@@ -306,7 +319,9 @@ fn search<M: Model>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::least_squares::PATIENCE;
+
+    /// The fits' patience ([`crate::diagnose::least_squares::PATIENCE`]).
+    const PATIENCE: usize = 10;
 
     #[test]
     fn a_parameter_pressed_against_its_bound_rests_on_it_and_the_others_fit_given_it() {

@@ -51,6 +51,7 @@ pub mod lines;
 pub mod loop_response;
 pub mod mechanical;
 pub mod mechanical_relation;
+pub mod param_spec;
 pub mod predictions;
 pub mod relations;
 #[cfg(test)]
