@@ -86,7 +86,7 @@ fn position(spec: &ParamSpec, u: f64) -> f64 {
 
 /// The residuals of `model` at coordinates `u`, the priors' rows appended; a row that is
 /// not finite counts as a large residual.
-pub fn full_residuals<M: Model>(model: &M, specs: &[ParamSpec], u: &[f64]) -> Vec<f64> {
+fn full_residuals<M: Model>(model: &M, specs: &[ParamSpec], u: &[f64]) -> Vec<f64> {
     let values: Vec<f64> = specs.iter().zip(u).map(|(s, u)| s.value(*u)).collect();
     let mut r = model.residuals(&values);
     for r in r.iter_mut() {
@@ -100,6 +100,11 @@ pub fn full_residuals<M: Model>(model: &M, specs: &[ParamSpec], u: &[f64]) -> Ve
         }
     }
     r
+}
+
+/// The objective at coordinates `u`: the sum of squares of [`full_residuals`].
+fn objective<M: Model>(model: &M, specs: &[ParamSpec], u: &[f64]) -> f64 {
+    full_residuals(model, specs, u).iter().map(|r| r * r).sum()
 }
 
 impl<M: Model> Problem<'_, M> {
@@ -132,11 +137,7 @@ impl<M: Model> Problem<'_, M> {
                 let mut on = u.clone();
                 on[k] = if p < 0.5 { lo } else { hi };
                 self.evaluations.fetch_add(1, Ordering::Relaxed);
-                let there: f64 = full_residuals(self.model, self.specs, &on)
-                    .iter()
-                    .map(|r| r * r)
-                    .sum();
-                there <= here
+                objective(self.model, self.specs, &on) <= here
             })
             .copied()
             .collect()
@@ -224,16 +225,12 @@ pub fn minimise<M: Model>(
 ) -> Minimum {
     let n = specs.len();
     let mut u = u0;
-    // A parameter pinned to one value (bounds that meet) is held from the start.
-    let mut held: Vec<bool> = specs.iter().map(|s| s.u_bounds.1 <= s.u_bounds.0).collect();
+    // A parameter pinned to one value (bounds that meet) is held from the start, and for
+    // good: there is no inside to try it at.
+    let pinned: Vec<bool> = specs.iter().map(|s| s.u_bounds.1 <= s.u_bounds.0).collect();
+    let mut held = pinned.clone();
     let mut may_hold = vec![true; n];
     let mut evaluations = 0;
-    let objective = |u: &[f64]| -> f64 {
-        full_residuals(model, specs, u)
-            .iter()
-            .map(|r| r * r)
-            .sum::<f64>()
-    };
     // Each round either holds a parameter more or frees one for good: at most 2n + 1.
     for _ in 0..=2 * n {
         let free: Vec<usize> = (0..n).filter(|&k| !held[k]).collect();
@@ -258,17 +255,20 @@ pub fn minimise<M: Model>(
         }
         // Nothing new on a bound: is each held parameter's bound still where the
         // objective falls?
-        let here = objective(&u);
+        let holding: Vec<usize> = (0..n).filter(|&k| held[k] && !pinned[k]).collect();
+        if holding.is_empty() {
+            break;
+        }
+        let here = objective(model, specs, &u);
         evaluations += 1;
         let mut freed = false;
-        let holding: Vec<usize> = (0..n).filter(|&k| held[k]).collect();
         for k in holding {
             let (lo, hi) = specs[k].u_bounds;
             let step = INSIDE_STEP * (hi - lo);
             let mut inside = u.clone();
             inside[k] = if u[k] <= lo { lo + step } else { hi - step };
             evaluations += 1;
-            if objective(&inside) < here {
+            if objective(model, specs, &inside) < here {
                 u[k] = inside[k];
                 held[k] = false;
                 may_hold[k] = false;
