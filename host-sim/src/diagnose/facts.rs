@@ -89,6 +89,9 @@ pub struct LogFacts {
     pub fill_pa: f64,
     /// Whether the piston moves (`x_m` logged and travelling).
     pub piston_moves: bool,
+    /// Whether the logged low side departs from the fill ([`low_side_apart`]): a pump
+    /// reversing into a blocked cylinder's low side pressurises it.
+    pub low_side_apart: bool,
     /// The logged piston position smoothed over ±[`POSITION_SMOOTHING_S`] (quadratic
     /// Savitzky–Golay), when the piston moves: the volume balance multiplies the position by
     /// the oil's stiffness A·β/V, 14 kPa per micrometre of a 71 cm² piston, so the
@@ -161,7 +164,13 @@ impl LogFacts {
         };
         let fill_low_pa = rig.fill.pressure_pa;
         let p_low = LowSide::of(log, fill_low_pa);
+        let low_side_apart = low_side_apart(log, fill_low_pa);
         let fill_pa = match log.p_low_pa.as_deref() {
+            // A blocked cylinder's low side pressurised by the reversing pump is never at
+            // the fill while the port is: the rig file's level.
+            Some(_) if low_side_apart && !moves(log) => {
+                rig.fill.pressure_pa - rig.fill.check_cracking_pa
+            }
             Some(pl) => {
                 let mut lower: Vec<f64> = log.p_pa.iter().zip(pl).map(|(a, b)| a.min(*b)).collect();
                 lower.sort_by(f64::total_cmp);
@@ -169,14 +178,7 @@ impl LogFacts {
             }
             None => rig.fill.pressure_pa - rig.fill.check_cracking_pa,
         };
-        let piston_moves = log.x_m.as_deref().is_some_and(|x| {
-            let (lo, hi) = x
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-                    (l.min(*v), h.max(*v))
-                });
-            hi - lo > MOVING_PISTON_TRAVEL_M
-        });
+        let piston_moves = moves(log);
         let x_smooth_m =
             log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
                 savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
@@ -211,6 +213,7 @@ impl LogFacts {
             angle_logged,
             fill_low_pa,
             fill_pa,
+            low_side_apart,
             piston_moves,
             x_smooth_m,
             piston_unseen,
@@ -501,6 +504,39 @@ pub fn unseen_piston_motion(log: &BenchLog, p_low: LowSide<'_>, rig: &Rig) -> bo
         0.0
     };
     displaced > 2.0 * (compression + absorber + leaked) + 1e-6
+}
+
+/// Whether `log`'s piston travels more than [`MOVING_PISTON_TRAVEL_M`] (`x_m` logged).
+fn moves(log: &BenchLog) -> bool {
+    log.x_m.as_deref().is_some_and(|x| {
+        let (lo, hi) = x
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                (l.min(*v), h.max(*v))
+            });
+        hi - lo > MOVING_PISTON_TRAVEL_M
+    })
+}
+
+/// How far the logged low side must depart from the fill pressure, on at least
+/// [`APART_SHARE`] of the rows, for the leakage's two paths to be told apart. [Pa]
+pub const LOW_SIDE_APART_PA: f64 = 1e6;
+
+/// Share of the rows on which the low side must depart ([`LOW_SIDE_APART_PA`]). [1]
+pub const APART_SHARE: f64 = 0.01;
+
+/// Whether `log`'s low side departs from the `fill` pressure enough to tell the leakage's
+/// port-to-port path from its path to the case: logged, and [`LOW_SIDE_APART_PA`] away on
+/// [`APART_SHARE`] of the rows. Otherwise the low side and the case sit at the same
+/// level and the logged low side is the measurement of both.
+pub fn low_side_apart(log: &BenchLog, fill: f64) -> bool {
+    log.p_low_pa.as_deref().is_some_and(|p| {
+        let apart = p
+            .iter()
+            .filter(|v| (**v - fill).abs() > LOW_SIDE_APART_PA)
+            .count();
+        apart as f64 > APART_SHARE * p.len() as f64
+    })
 }
 
 #[cfg(test)]

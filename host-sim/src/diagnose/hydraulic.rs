@@ -7,16 +7,23 @@
 //! it, eq. 9–11 and 22–26 of the paper as the plant model writes them:
 //!
 //! ```text
-//!   (V_h + A·x)/β · dp/dt = D/2π·s(θ)·ω − G·(p − p_low) − A·dx/dt − q
+//!   (V_h + A·x)/β · dp/dt = D/2π·s(θ)·ω − G_pp·(p − p_low) − (G − G_pp)·(p − p_c) − A·dx/dt − q
 //!   I·dq/dt = p − p_gas(v) − R·q,        dv/dt = q        (absorber inlet and gas)
 //!   p_meas = g·p_s + o,                 τ·dp_s/dt = p − p_s   (transducer)
 //! ```
 //!
 //! with V_h the high-side volume at mid-stroke (chamber and line), G the total leakage from
-//! the high side (pump internal and external, cylinder cross-piston: eq. 9–10 with the low
-//! side and case both near the fill pressure), s(θ) the pump's displacement factor (eq. 20,
-//! the plant's [`Pump`]), p_gas the polytropic gas law of the plant's [`GasCharge`] (no
-//! flow into an empty absorber below its precharge).
+//! the high side (eq. 9–10): G_pp of it from port to port (the pump's internal leakage and
+//! the cylinder's cross-piston leakage) towards the low side's pressure p_low, the rest
+//! (the pump's external leakage and any extra) to the case at the fill pressure p_c — a
+//! low side pressurised by a reversing pump on a blocked cylinder feeds the port through
+//! the first path only; the case's pressure is the fill's, which the logged low side
+//! measures while it sits there. G_pp is a share of G while G stays within its tolerance
+//! band ([`LEAKAGE_BAND`]) and that share of the band's top beyond it: an extra leakage
+//! drains to the case, as the catalogue's does. The share is the rig file's unless the
+//! log's low side departs from the fill, which alone tells the two paths apart. s(θ) the
+//! pump's displacement factor (eq. 20, the plant's [`Pump`]), p_gas the polytropic gas law
+//! of the plant's [`GasCharge`] (no flow into an empty absorber below its precharge).
 //!
 //! Each log interval is cut into substeps of at most [`MAX_SUBSTEP_S`], each solved with
 //! the backward Euler rule linearised about the gas state, closed form: the oil's
@@ -63,6 +70,11 @@ pub struct HydraulicParams {
     pub inlet_resistance_pa_s_m3: f64,
     /// Total leakage conductance from the high side, G. [(m³/s)/Pa]
     pub leakage_m3_s_pa: f64,
+    /// The port-to-port part's share of G within the band. [1]
+    pub port_to_port_share: f64,
+    /// The top of G's tolerance band, beyond which the port-to-port part stays put.
+    /// [(m³/s)/Pa]
+    pub leakage_top_m3_s_pa: f64,
     /// Transducer gain g. [1]
     pub sensor_gain: f64,
     /// Transducer offset o. [Pa]
@@ -77,6 +89,8 @@ impl HydraulicParams {
     /// The rig file's values.
     pub fn nominal(rig: &Rig) -> HydraulicParams {
         let a = &rig.absorber;
+        let port_to_port =
+            rig.pump.internal_leakage_m3_s_pa + rig.cylinder.internal_leakage_m3_s_pa;
         HydraulicParams {
             displacement_m3_per_rev: rig.pump.displacement_m3_per_rev,
             high_side_volume_m3: rig.cylinder.chamber_a_volume_m3,
@@ -90,6 +104,12 @@ impl HydraulicParams {
             inlet_inertance_kg_m4: a.inlet_inertance_kg_m4,
             inlet_resistance_pa_s_m3: a.inlet_resistance_pa_s_m3,
             leakage_m3_s_pa: nominal_leakage(rig),
+            port_to_port_share: if nominal_leakage(rig) > 0.0 {
+                port_to_port / nominal_leakage(rig)
+            } else {
+                0.0
+            },
+            leakage_top_m3_s_pa: nominal_leakage(rig) * LEAKAGE_BAND.1,
             sensor_gain: 1.0,
             sensor_offset_pa: rig.sensors.pressure.offset_pa,
             sensor_lag_s: rig.sensors.pressure.lag_time_constant_s,
@@ -109,9 +129,11 @@ impl HydraulicParams {
     }
 }
 
+/// Tolerance band of the total leakage as fractions of the rig file's. [1]
+pub const LEAKAGE_BAND: (f64, f64) = (0.8, 1.2);
+
 /// The rig file's total leakage from the high side of a blocked cylinder: the pump's
-/// internal and external leakage and the cylinder's cross-piston leakage (the low side
-/// and the case both sit near the fill pressure). [(m³/s)/Pa]
+/// internal and external leakage and the cylinder's cross-piston leakage. [(m³/s)/Pa]
 pub fn nominal_leakage(rig: &Rig) -> f64 {
     rig.pump.internal_leakage_m3_s_pa
         + rig.pump.external_leakage_m3_s_pa
@@ -128,6 +150,9 @@ pub struct HydraulicInputs<'a> {
     pub theta_rad: &'a [f64],
     /// Low-side pressure. [Pa]
     pub p_low_pa: LowSide<'a>,
+    /// The case's pressure p_c the leakage's other path drains to: the fill's, which the
+    /// logged low side measures while it sits there ([`LogFacts::low_side_apart`]). [Pa]
+    pub case_pa: LowSide<'a>,
     /// Piston position, when it moves. [m]
     pub x_m: Option<&'a [f64]>,
     /// Measured pressure (window starts). [Pa]
@@ -145,13 +170,19 @@ impl<'a> HydraulicInputs<'a> {
             t_s: &log.t_s,
             theta_rad: &facts.theta_rad,
             p_low_pa: facts.p_low(log),
+            case_pa: if facts.low_side_apart {
+                LowSide::Level(facts.fill_low_pa)
+            } else {
+                facts.p_low(log)
+            },
             x_m: facts.x_smooth_m.as_deref(),
             p_pa: &log.p_pa,
             start_rows: rows_spanning(START_S, facts.period_s, 2),
             // The check valve opens only where the port is the suction side: a moving
-            // payload's. A blocked cylinder's port stays above the fill, and there the floor
-            // would only bend the windows' start, which is fitted as if linear.
-            fill_pa: if facts.piston_moves {
+            // payload's, or a blocked cylinder's whose pump reverses into a low side it
+            // pressurises. Elsewhere a blocked cylinder's port stays above the fill, and
+            // there the floor would only bend the windows' start, fitted as if linear.
+            fill_pa: if facts.piston_moves || facts.low_side_apart {
                 facts.fill_pa
             } else {
                 f64::NEG_INFINITY
@@ -314,7 +345,7 @@ impl Hydraulics {
                 Some(xm) => (xm[k], xm[next] - xm[k]),
                 None => (0.0, 0.0),
             };
-            let p_low = x.p_low_pa.at(k);
+            let (p_low, p_case) = (x.p_low_pa.at(k), x.case_pa.at(k));
             // Flow into the node over a substep: pump minus piston, as a mean [m³/s]; and
             // the oil's capacitance at the piston's position [m³/Pa]. Both are the row's
             // own unless the pump ripples or the piston moves.
@@ -338,7 +369,7 @@ impl Hydraulics {
                     (q_at(factor), c_at(f))
                 };
                 for st in st.iter_mut() {
-                    self.substep(st, h, [q_in, p_low, floor], c_oil, lag.1);
+                    self.substep(st, h, [q_in, p_low, p_case, floor], c_oil, lag.1);
                 }
             }
             for (o, st) in out.iter_mut().zip(&st) {
@@ -372,11 +403,12 @@ impl Hydraulics {
     /// One backward-Euler substep of length `h` with inflow `q_in`, see the module docs;
     /// `lag` is the transducer's step factor 1 − e^(−h/τ).
     #[inline]
-    fn substep(&self, st: &mut State, h: f64, flows: [f64; 3], c_oil: f64, lag: f64) {
-        let [q_in, p_low, floor] = flows;
+    fn substep(&self, st: &mut State, h: f64, flows: [f64; 4], c_oil: f64, lag: f64) {
+        let [q_in, p_low, p_case, floor] = flows;
         let hp = &self.params;
         let g = hp.leakage_m3_s_pa;
-        let rhs = c_oil * st.p + h * q_in + h * g * p_low;
+        let g_pp = hp.port_to_port_share * g.min(hp.leakage_top_m3_s_pa);
+        let rhs = c_oil * st.p + h * q_in + h * (g_pp * p_low + (g - g_pp) * p_case);
         let diag = c_oil + h * g;
         let mut p_new = rhs / diag;
         if let Some(gas) = &hp.absorber {
@@ -425,6 +457,7 @@ mod tests {
             t_s: t,
             theta_rad: th,
             p_low_pa: LowSide::Logged(&pl),
+            case_pa: LowSide::Level(0.5e6),
             x_m: None,
             p_pa: &p,
             start_rows: 10,
@@ -469,6 +502,26 @@ mod tests {
         let hp = HydraulicParams::nominal(&rig);
         let (p0, pl) = (5e6, 0.5e6);
         let w = 2.0 * PI * hp.leakage_m3_s_pa * (p0 - pl) / hp.displacement_m3_per_rev;
+        let n = 2000;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let th: Vec<f64> = t.iter().map(|t| w * t).collect();
+        let out = open_loop(&hp, &t, &th, pl, p0);
+        for y in &out {
+            assert!((y - p0).abs() < 10.0, "{y}");
+        }
+    }
+
+    #[test]
+    fn a_pressurised_low_side_feeds_the_port_through_the_port_to_port_path_only() {
+        // The nominal rig's leakages (nominal-rig.md): pump internal and cylinder
+        // cross-piston 1e-13 (m³/s)/Pa each from port to port, the pump's external 1e-13 to
+        // the case at the 0.5 MPa fill. A port held at 2.65 MPa against a low side at
+        // 15 MPa gains 2e-13·12.35e6 − 1e-13·2.15e6 = 2.255e-6 m³/s, which a pump turning
+        // backwards at ω = −2π·2.255e-6/D takes away: the pressure holds.
+        let rig = Rig::nominal();
+        let hp = HydraulicParams::nominal(&rig);
+        let (p0, pl) = (2.65e6, 15e6);
+        let w = -2.0 * PI * 2.255e-6 / rig.pump.displacement_m3_per_rev;
         let n = 2000;
         let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
         let th: Vec<f64> = t.iter().map(|t| w * t).collect();

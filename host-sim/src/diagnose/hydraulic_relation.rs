@@ -6,7 +6,7 @@
 use crate::bench_log::{BenchLog, Signal};
 use crate::diagnose::calibration::{scaled, Relation, Release};
 use crate::diagnose::facts::LogFacts;
-use crate::diagnose::hydraulic::{HydraulicInputs, HydraulicParams, Hydraulics};
+use crate::diagnose::hydraulic::{HydraulicInputs, HydraulicParams, Hydraulics, LEAKAGE_BAND};
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use plant_model::accumulator::GasCharge;
 use plant_model::Rig;
@@ -48,10 +48,14 @@ pub mod hyd {
     /// Pump displacement (only the piston's volume is absolute: a blocked cylinder leaves
     /// it to its prior).
     pub const DISPLACEMENT: usize = 9;
+    /// The port-to-port share of the leakage.
+    pub const PORT_SHARE: usize = 10;
 }
 
-/// The hydraulic relation's search space on `rig`, with `release` out of its band.
-pub fn hydraulic_specs(rig: &Rig, release: Release) -> Vec<ParamSpec> {
+/// The hydraulic relation's search space on `rig`, with `release` out of its band; the
+/// leakage's port-to-port share free (anywhere from 0 to 1) when `split`, else the rig
+/// file's.
+pub fn hydraulic_specs(rig: &Rig, release: Release, split: bool) -> Vec<ParamSpec> {
     let n = HydraulicParams::nominal(rig);
     let gas = n.absorber.unwrap_or(GasCharge {
         shell_volume_m3: 1e-4,
@@ -113,8 +117,10 @@ pub fn hydraulic_specs(rig: &Rig, release: Release) -> Vec<ParamSpec> {
             ParamSpec::log("leakage_m3_s_pa", n.leakage_m3_s_pa.max(1e-16), 0.8, 30.0)
                 .starting_at(1.5 * n.leakage_m3_s_pa)
         } else {
-            ParamSpec::log("leakage_m3_s_pa", n.leakage_m3_s_pa.max(1e-16), 0.05, 30.0)
-                .with_band(0.8 * n.leakage_m3_s_pa, 1.2 * n.leakage_m3_s_pa)
+            ParamSpec::log("leakage_m3_s_pa", n.leakage_m3_s_pa.max(1e-16), 0.05, 30.0).with_band(
+                LEAKAGE_BAND.0 * n.leakage_m3_s_pa,
+                LEAKAGE_BAND.1 * n.leakage_m3_s_pa,
+            )
         },
         ParamSpec::linear("sensor_gain", 1.0, 0.01, 0.8, 1.2).with_band(0.99, 1.01),
         ParamSpec::linear("sensor_offset_pa", n.sensor_offset_pa, 1e4, -1e6, 1e6).with_band(
@@ -132,6 +138,15 @@ pub fn hydraulic_specs(rig: &Rig, release: Release) -> Vec<ParamSpec> {
             0.95 * n.displacement_m3_per_rev,
             1.05 * n.displacement_m3_per_rev,
         ),
+        {
+            let share =
+                ParamSpec::linear("port_to_port_share", n.port_to_port_share, 0.1, 0.0, 1.0);
+            if split {
+                share.with_band(0.0, 1.0)
+            } else {
+                share.with_band(n.port_to_port_share, n.port_to_port_share)
+            }
+        },
     ]
 }
 
@@ -150,6 +165,7 @@ pub fn hydraulic_params(rig: &Rig, v: &[f64]) -> HydraulicParams {
     p.sensor_offset_pa = v[hyd::OFFSET];
     p.sensor_lag_s = v[hyd::LAG];
     p.displacement_m3_per_rev = v[hyd::DISPLACEMENT];
+    p.port_to_port_share = v[hyd::PORT_SHARE];
     p
 }
 
@@ -184,6 +200,20 @@ pub struct HydraulicRelation<'a> {
     pub facts: &'a LogFacts,
     /// The rig file.
     pub rig: &'a Rig,
+    /// Whether the leakage's port-to-port share is fitted ([`LogFacts::low_side_apart`]).
+    pub split: bool,
+}
+
+impl<'a> HydraulicRelation<'a> {
+    /// The relation of `log` with its `facts` on `rig`.
+    pub fn of(log: &'a BenchLog, facts: &'a LogFacts, rig: &'a Rig) -> HydraulicRelation<'a> {
+        HydraulicRelation {
+            log,
+            facts,
+            rig,
+            split: facts.low_side_apart,
+        }
+    }
 }
 
 /// Closest ratio of two shooting-window start pressures between which the precharge grid
@@ -235,7 +265,7 @@ impl Relation for HydraulicRelation<'_> {
         self.facts
     }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
-        hydraulic_specs(self.rig, release)
+        hydraulic_specs(self.rig, release, self.split)
     }
 
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
