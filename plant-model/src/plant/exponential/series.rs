@@ -260,8 +260,8 @@ impl Terms {
             ),
         };
         if K > 0 {
-            rd = rd + cd * hd;
-            rq = rq + cq * hq;
+            rd += cd * hd;
+            rq += cq * hq;
             if TURNING {
                 let b = &self.b;
                 rd = rd + b[0][0] * z1[0] + b[0][1] * z1[1];
