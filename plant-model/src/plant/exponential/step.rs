@@ -201,7 +201,8 @@ impl Plant {
     ) {
         let at1 = seg.at;
         let (x0, g0, inputs) = (start.x, start.g, start.inputs);
-        let mut x = seg.x;
+        self.x = seg.x;
+        let x = &mut self.x;
         let (d_theta, d_x) = (x[ix::THETA] - x0[ix::THETA], x[ix::X] - x0[ix::X]);
         x[ix::E_IN] += seg.e_in;
         x[ix::E_CU] += seg.e_cu;
@@ -210,7 +211,6 @@ impl Plant {
             + self.piston_friction.force(self.discrete.piston) * d_x;
         x[ix::E_HYD] += seg.hyd_loss;
         x[ix::E_EXT] += -inputs.external_force_n * d_x - inputs.external_torque_nm * d_theta;
-        self.x = x;
         let theta = x[ix::THETA];
         if self.rotor.rotations >= ROTOR_RESYNC_STEPS {
             // The phasor taken afresh from the angle moves the angle terms by rounding: the
