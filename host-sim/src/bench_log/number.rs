@@ -3,140 +3,77 @@
 //! [1e-5, 1e16) and zero, exponent notation (`{:e}`) beyond, where positional would spell
 //! out dozens of zeros.
 //!
-//! The digits come from the `ryu` crate (Ryū, Adams 2018: the shortest round-trip digits,
+//! The text comes from the `ryu` crate (Ryū, Adams 2018: the shortest round-trip digits,
 //! the nearest of them when several are as short — the digits Rust's formatter chooses too),
 //! at a fraction of the cost of `core::fmt`'s Grisu/Dragon path: formatting a log's numbers
-//! took a fifth of an `eha simulate` run. The layout is rebuilt here from the digits and
-//! their decimal exponent, so a file's text is byte for byte what `write!(s, "{v}")` or
-//! `write!(s, "{v:e}")` gives (checked against them in the tests below).
+//! took a fifth of an `eha simulate` run. Ryū's layout is Rust's but for a whole number's
+//! trailing `.0` (`100.0` where Rust writes `100`): the same positional range (the decimal
+//! point between 4 places before the first digit and 16 after it), the same exponent
+//! notation (`1e-7`, `1.234e33`). So the text is Ryū's with that suffix dropped, byte for
+//! byte what `write!(s, "{v}")` or `write!(s, "{v:e}")` gives (checked against them in the
+//! tests below), except where two shortest decimals may be equally near, which Rust's own
+//! formatting spells.
 
 /// Appends the text of `v` to `out`.
 pub fn push(out: &mut String, v: f64) {
-    let mut buf = Text::default();
-    spell(&mut buf, v);
-    out.push_str(buf.as_str());
+    let mut buf = ryu::Buffer::new();
+    match spell(&mut buf, v) {
+        Some(text) => out.push_str(text),
+        None => push_std(out, v),
+    }
 }
 
 /// Appends the text of `v` to the bytes `out`.
 pub fn push_bytes(out: &mut Vec<u8>, v: f64) {
-    let mut buf = Text::default();
-    spell(&mut buf, v);
-    out.extend_from_slice(&buf.bytes[..buf.len]);
-}
-
-/// A number's text, at most 26 bytes (`-1.2345678901234567e-308`).
-struct Text {
-    bytes: [u8; 40],
-    len: usize,
-}
-
-impl Default for Text {
-    fn default() -> Self {
-        Text {
-            bytes: [b'0'; 40],
-            len: 0,
+    let mut buf = ryu::Buffer::new();
+    match spell(&mut buf, v) {
+        Some(text) => out.extend_from_slice(text.as_bytes()),
+        None => {
+            let mut s = String::new();
+            push_std(&mut s, v);
+            out.extend_from_slice(s.as_bytes());
         }
     }
 }
 
-impl Text {
-    fn push(&mut self, b: u8) {
-        if self.len < self.bytes.len() {
-            self.bytes[self.len] = b;
-            self.len += 1;
-        }
-    }
-
-    fn push_all(&mut self, s: &[u8]) {
-        for b in s {
-            self.push(*b);
-        }
-    }
-
-    fn as_str(&self) -> &str {
-        // Only ASCII is ever written.
-        core::str::from_utf8(&self.bytes[..self.len]).unwrap_or("NaN")
-    }
-}
-
-/// Spells `v` into `out`.
-fn spell(out: &mut Text, v: f64) {
+/// Rust's own formatting of `v` in the log's layout (the reference, and the path of the
+/// possible ties, NaN and the infinities, which never reach a checked log).
+fn push_std(out: &mut String, v: f64) {
+    use std::fmt::Write as _;
     let a = v.abs();
-    let mut ryu_buf = ryu::Buffer::new();
-    let decomposed = (v.is_finite() && a != 0.0).then(|| decompose(ryu_buf.format_finite(v)));
-    // Two shortest decimals can be equally near a double; Ryū then takes the even one,
-    // Rust the upper. Rust's own formatting spells the cases that may be such a tie (and
-    // zero, NaN and the infinities, which never reach a checked log).
-    let Some((negative, d, point)) = decomposed.filter(|(_, d, point)| !maybe_tie(v, d, *point))
-    else {
-        use std::fmt::Write as _;
-        let mut s = String::new();
-        let _ = if a == 0.0 || (1e-5..1e16).contains(&a) {
-            write!(s, "{v}")
-        } else {
-            write!(s, "{v:e}")
-        };
-        out.push_all(s.as_bytes());
-        return;
-    };
-    let digits = &d.buf[..d.len];
-    if negative {
-        out.push(b'-');
-    }
-    let n = digits.len() as i32;
-    if (1e-5..1e16).contains(&a) {
-        // Positional, the decimal point `point` digits after the first digit's place.
-        if point <= 0 {
-            out.push_all(b"0.");
-            for _ in 0..-point {
-                out.push(b'0');
-            }
-            out.push_all(digits);
-        } else if point < n {
-            let (int, frac) = digits.split_at(point as usize);
-            out.push_all(int);
-            out.push(b'.');
-            out.push_all(frac);
-        } else {
-            out.push_all(digits);
-            for _ in 0..point - n {
-                out.push(b'0');
-            }
-        }
+    let _ = if a == 0.0 || (1e-5..1e16).contains(&a) {
+        write!(out, "{v}")
     } else {
-        let (first, rest) = digits.split_at(1);
-        out.push_all(first);
-        if !rest.is_empty() {
-            out.push(b'.');
-            out.push_all(rest);
-        }
-        out.push(b'e');
-        let exp = point - 1;
-        if exp < 0 {
-            out.push(b'-');
-        }
-        let e = exp.unsigned_abs();
-        if e >= 100 {
-            out.push(b'0' + (e / 100) as u8);
-        }
-        if e >= 10 {
-            out.push(b'0' + (e / 10 % 10) as u8);
-        }
-        out.push(b'0' + (e % 10) as u8);
-    }
+        write!(out, "{v:e}")
+    };
 }
 
-/// Whether Ryū's `d` (decimal point at `point`) for `v` may be one of two equally near
-/// shortest decimals. A tie needs the exact value to sit halfway between two n-digit
-/// decimals: its own expansion is then n + 1 digits ending in 5. The exact value m·2^e
-/// (m odd) is an integer for e ≥ 0, never such a midpoint; for e < 0 it has −e fractional
-/// digits, point − e significant ones. So a tie needs e < 0, more exact digits than Ryū's n
-/// but at most 18, and Ryū's last digit even (it rounds ties to even).
-fn maybe_tie(v: f64, d: &Digits, point: i32) -> bool {
+/// The text of `v` from Ryū in `buf`, or `None` where Rust's own formatting must spell it
+/// (not finite, or possibly a tie).
+#[inline]
+fn spell(buf: &mut ryu::Buffer, v: f64) -> Option<&str> {
+    if !v.is_finite() {
+        return None;
+    }
+    let text = buf.format_finite(v);
+    let text = text.strip_suffix(".0").unwrap_or(text);
+    (!maybe_tie(v, text.as_bytes())).then_some(text)
+}
+
+/// Whether Ryū's `text` for `v` may be one of two equally near shortest decimals (Ryū then
+/// takes the even one, Rust's formatting not necessarily). Equally near n-digit decimals
+/// are neighbours (any between them would be nearer) and `v` is their midpoint: its exact
+/// decimal expansion has n + 1 significant digits. The exact value m·2^e (m odd) is an
+/// integer for e ≥ 0, never such a midpoint; for e < 0 it has −e fractional digits, so
+/// point − e significant ones (value = 0.d₁d₂… × 10^point). So a tie needs e < 0 and
+/// point − e = n + 1 ≤ 18. The decimal point's place is bounded from the binary exponent
+/// first (10^(point − 1) ≤ |v| < 2^(E + 1)), which rules out nearly every value before the
+/// text is read.
+fn maybe_tie(v: f64, text: &[u8]) -> bool {
     let bits = v.to_bits();
     let raw_exp = ((bits >> 52) & 0x7ff) as i32;
     let frac = bits & ((1u64 << 52) - 1);
-    let (m, mut e) = if raw_exp == 0 {
+    let (m, e) = if raw_exp == 0 {
         (frac, -1074)
     } else {
         (frac | (1u64 << 52), raw_exp - 1075)
@@ -144,76 +81,68 @@ fn maybe_tie(v: f64, d: &Digits, point: i32) -> bool {
     if m == 0 {
         return false;
     }
-    e += m.trailing_zeros() as i32;
-    let exact = point - e;
-    let n = d.len as i32;
-    e < 0 && n < exact && exact <= 18 && d.buf[d.len - 1] % 2 == 0
-}
-
-/// Significant decimal digits, at most 17 for an f64.
-struct Digits {
-    buf: [u8; 32],
-    len: usize,
-}
-
-/// Sign, significant digits (no leading or trailing zeros) and the position of the decimal
-/// point relative to the first of them (value = 0.d₁d₂… × 10^point) of Ryū's text of a
-/// finite, non-zero number (`1.5`, `0.0001234`, `1e-7`, `1.2345e20`, `100.0`), in one pass
-/// over its bytes.
-fn decompose(text: &str) -> (bool, Digits, i32) {
-    let bytes = text.as_bytes();
-    let mut d = Digits {
-        buf: [b'0'; 32],
-        len: 0,
-    };
-    let mut k = 0;
-    let negative = bytes.first() == Some(&b'-');
-    if negative {
-        k = 1;
+    let e = e + m.trailing_zeros() as i32;
+    if e >= 0 {
+        return false;
     }
-    // Digits before the point (or the exponent) count towards it; leading zeros move it.
+    // |v| ≥ 2^E with E = raw_exp − 1023 (normal numbers): point ≥ ⌊E·log₁₀2⌋ + 1.
+    if raw_exp != 0 {
+        let lowest = (f64::from(raw_exp - 1023) * std::f64::consts::LOG10_2).floor() as i32 + 1;
+        if lowest - e > 18 {
+            return false;
+        }
+    }
+    let (n, point) = digits_and_point(text);
+    point - e == n + 1
+}
+
+/// The number of significant digits of Ryū's `text` (finite, non-zero, its whole number's
+/// `.0` dropped) and the place of its decimal point (value = 0.d₁d₂… × 10^point).
+fn digits_and_point(text: &[u8]) -> (i32, i32) {
+    let body = text.strip_prefix(b"-").unwrap_or(text);
+    let (mantissa, exp) = match body.iter().position(|b| *b == b'e') {
+        Some(k) => {
+            let (m, rest) = body.split_at(k);
+            let rest = &rest[1..];
+            let (neg, digits) = match rest.strip_prefix(b"-") {
+                Some(d) => (true, d),
+                None => (false, rest),
+            };
+            let x = digits
+                .iter()
+                .fold(0i32, |x, b| 10 * x + i32::from(b - b'0'));
+            (m, if neg { -x } else { x })
+        }
+        None => (body, 0),
+    };
+    let mut n = 0i32;
     let mut point = 0i32;
     let mut seen_point = false;
-    while let Some(&b) = bytes.get(k) {
-        match b {
-            b'0'..=b'9' => {
-                if d.len == 0 && b == b'0' {
-                    if seen_point {
-                        point -= 1;
-                    }
-                } else {
-                    if !seen_point {
-                        point += 1;
-                    }
-                    if d.len < d.buf.len() {
-                        d.buf[d.len] = b;
-                        d.len += 1;
-                    }
-                }
+    let mut leading = true;
+    let mut zeros = 0i32;
+    for &b in mantissa {
+        if b == b'.' {
+            seen_point = true;
+            continue;
+        }
+        if leading && b == b'0' {
+            if seen_point {
+                point -= 1;
             }
-            b'.' => seen_point = true,
-            _ => break,
+            continue;
         }
-        k += 1;
-    }
-    // The exponent, if any, after the `e`.
-    if bytes.get(k) == Some(&b'e') {
-        k += 1;
-        let neg = bytes.get(k) == Some(&b'-');
-        if neg {
-            k += 1;
+        leading = false;
+        if !seen_point {
+            point += 1;
         }
-        let mut e = 0i32;
-        while let Some(&b) = bytes.get(k) {
-            e = 10 * e + i32::from(b - b'0');
-            k += 1;
+        if b == b'0' {
+            zeros += 1;
+        } else {
+            n += zeros + 1;
+            zeros = 0;
         }
-        point += if neg { -e } else { e };
     }
-    while d.len > 1 && d.buf[d.len - 1] == b'0' {
-        d.len -= 1;
-    }
-    (negative, d, point)
+    (n, point + exp)
 }
 
 #[cfg(test)]
@@ -267,8 +196,39 @@ mod tests {
             0.1f32 as f64,
             1e300,
             1e-300,
+            5.960464477539063e-8,
+            280.1000061035156,
+            f64::MIN_POSITIVE / 3.0,
         ] {
             assert_eq!(ours(v), std_text(v), "{v:?}");
+        }
+    }
+
+    #[test]
+    fn text_is_rusts_own_for_short_binary_fractions() {
+        // Values with few exact decimal digits (m·2^−k, m small) hold the midpoints of two
+        // shortest decimals, where Ryū and Rust may choose differently.
+        for k in 1..80 {
+            for m in [
+                1u64,
+                3,
+                5,
+                7,
+                11,
+                13,
+                255,
+                1023,
+                65535,
+                0x1f_ffff,
+                0x3f_ffff_ffff,
+            ] {
+                for s in [1.0, -1.0] {
+                    let v = s * m as f64 * 2f64.powi(-k);
+                    assert_eq!(ours(v), std_text(v), "{v:?}");
+                    let w = v * 1e10;
+                    assert_eq!(ours(w), std_text(w), "{w:?}");
+                }
+            }
         }
     }
 

@@ -220,7 +220,11 @@ impl Plant {
             lag_filter: (f64::NAN, 0.0, 0.0),
         };
         plant.angle = plant.angle_terms(init.theta_m_rad);
-        plant.exp = History::new(&plant.motor, &plant.inverter);
+        plant.exp = History::new(
+            &plant.motor,
+            &plant.inverter,
+            [plant.absorber.gas.exponent, plant.fill_gas.exponent],
+        );
         plant.stored0_j = plant.stored_energy_j(&plant.x);
         Ok(plant)
     }

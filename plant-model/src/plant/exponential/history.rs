@@ -1,10 +1,12 @@
 //! What the exponential integrator carries from step to step: the rates at the present
 //! state, their divided differences over the last two steps and the quadratic extrapolation
 //! they give (Newton's divided differences on the actual step lengths), the hydraulic block's
-//! matrix functions with what they were built for, and the winding's constants.
+//! matrix functions with what they were built for, the winding's constants and the gases'
+//! polytropic series.
 
 use super::blocks::Phi;
 use super::rates::Rates;
+use super::segment::GasSeries;
 
 /// What the integrator carries from step to step.
 #[derive(Clone, Debug, Default)]
@@ -21,6 +23,8 @@ pub(in crate::plant) struct History {
     pub(super) block: Option<HydroBlock>,
     /// The winding's constants.
     pub(super) winding: WindingConsts,
+    /// The polytropic series' coefficients of the absorber's and the fill accumulator's gas.
+    pub(super) gas: [GasSeries; 2],
 }
 
 /// The winding's constants, computed once.
@@ -78,10 +82,12 @@ pub(super) struct HydroBlock {
 }
 
 impl History {
-    /// A history for a plant with `motor` driven by `inverter`, empty.
+    /// A history for a plant with `motor` driven by `inverter` and gases of `gas_exponents`
+    /// (the absorber's, the fill accumulator's), empty.
     pub(in crate::plant) fn new(
         motor: &crate::motor::Motor,
         inverter: &crate::inverter::Inverter,
+        gas_exponents: [f64; 2],
     ) -> Self {
         let inv_l = [1.0 / motor.l_d_h, 1.0 / motor.l_q_h];
         let coupling = [motor.l_q_h / motor.l_d_h, -motor.l_d_h / motor.l_q_h];
@@ -98,6 +104,7 @@ impl History {
                 nu_r: (motor.r_s_ohm + band) * inv_l[0].max(inv_l[1]),
                 nu_w: coupling[0].max(-coupling[1]),
             },
+            gas: gas_exponents.map(GasSeries::new),
             ..History::default()
         }
     }

@@ -9,7 +9,7 @@
 //! and the speed couples the axes) and port A's node against the oil column of the absorber's
 //! inlet (1/√(I·C_oil) ≈ 1.9e3 rad/s, damping ratio 0.02 at the nominal rig). Both are
 //! linear at a given speed and chamber volume, so their exact solution over a step is cheap
-//! ([`blocks`]); everything else — the shaft, port B, the piston, the gases, the valves,
+//! ([`series`], [`blocks`]); everything else — the shaft, port B, the piston, the gases, the valves,
 //! the angle-dependent torques and flows — changes on millisecond scales and is well served
 //! by a polynomial extrapolation of its rates over the step.
 //!
@@ -78,8 +78,8 @@
 //!
 //! # Where each part lives
 //! [`step`] takes a step (segments, event location, commit); [`segment`] integrates one
-//! segment, with [`winding`] for the currents by the series of [`blocks`] and
-//! [`hydro_block`] for the hydraulic block; [`explicit`] evaluates the [`rates`];
+//! segment, with [`winding`] for the currents by the series of [`series`] and
+//! [`hydro_block`] for the hydraulic block by the matrix functions of [`blocks`]; [`explicit`] evaluates the [`rates`];
 //! [`events`] holds the event functions and the projection; [`history`] what is carried
 //! from step to step.
 
@@ -90,6 +90,7 @@ mod history;
 mod hydro_block;
 mod rates;
 mod segment;
+mod series;
 mod step;
 mod winding;
 

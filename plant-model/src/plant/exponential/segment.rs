@@ -53,7 +53,6 @@ impl Plant {
     pub(super) fn exp_segment(&self, start: &Start, poly: &Poly, tau: f64) -> Segment {
         let (x0, g0, inputs) = (start.x, start.g, start.inputs);
         let (g1, g2) = (&poly.g1, &poly.g2);
-        let mut x = *x0;
         // ∫ over the segment of c0 + c1·t + c2·t², and of (τ − t)·(…).
         let t2 = tau * tau;
         let t3 = t2 * tau;
@@ -73,7 +72,7 @@ impl Plant {
             0.0
         };
         let mut seg = Segment {
-            x,
+            x: *x0,
             at: *start.at,
             e_in: 0.0,
             e_cu: 0.0,
@@ -108,8 +107,8 @@ impl Plant {
                 Shaft::default()
             };
             let o = self.winding_step(x0, start.at, g0, poly, &duties, &shaft, tau);
-            x[ix::ID] = o.i[0];
-            x[ix::IQ] = o.i[1];
+            seg.x[ix::ID] = o.i[0];
+            seg.x[ix::IQ] = o.i[1];
             if shaft_free {
                 omega_mid = Some(o.omega_e_mid / p);
             }
@@ -121,10 +120,10 @@ impl Plant {
         let w0 = x0[ix::OMEGA];
         if shaft_free {
             let (i_t, i2_t) = torque;
-            x[ix::OMEGA] = w0 + (i_t + int(l0, g1.t_load, g2.t_load)) * inv_j;
-            x[ix::THETA] =
+            seg.x[ix::OMEGA] = w0 + (i_t + int(l0, g1.t_load, g2.t_load)) * inv_j;
+            seg.x[ix::THETA] =
                 x0[ix::THETA] + tau * w0 + (i2_t + moment(l0, g1.t_load, g2.t_load)) * inv_j;
-            seg.at = self.angle_after(start.at, x[ix::THETA]);
+            seg.at = self.angle_after(start.at, seg.x[ix::THETA]);
         }
         // The pump's geometric flow D·s(θ)·ω from the shaft's own speed (it follows the
         // torque within the step, which the rates' extrapolation cannot), quadratic through
@@ -138,7 +137,7 @@ impl Plant {
         let pump = &self.pump;
         let q0 = pump.geometric_flow(w0, f0);
         let qm = pump.geometric_flow(w_mid, 0.5 * (f0 + f1));
-        let q1 = pump.geometric_flow(x[ix::OMEGA], f1);
+        let q1 = pump.geometric_flow(seg.x[ix::OMEGA], f1);
         let pump_c = [
             q0,
             (4.0 * qm - 3.0 * q0 - q1) / tau,
@@ -209,8 +208,8 @@ impl Plant {
         let forcing = |k: usize, t: f64| f[0][k] + t * (f[1][k] + t * f[2][k]);
         let hermite =
             |a0: f64, a1: f64, d0: f64, d1: f64| 0.5 * tau * (a0 + a1) + t2 / 12.0 * (d0 - d1);
-        x[ix::PA] = y1[0];
-        x[ix::PB] = y1[2];
+        seg.x[ix::PA] = y1[0];
+        seg.x[ix::PB] = y1[2];
         if key.open {
             let inv_i = 1.0 / a.inertance_kg_m4;
             let r_i = a.resistance_pa_s_m3 * inv_i;
@@ -220,33 +219,34 @@ impl Plant {
             let d_oil = hermite(q0, q1, dq0, dq1);
             seg.hyd_loss += a.resistance_pa_s_m3
                 * (0.5 * tau * (q0 * q0 + q1 * q1) + t2 / 6.0 * (q0 * dq0 - q1 * dq1));
-            x[ix::ABS_Q] = q1;
-            x[ix::ABS_OIL] = x0[ix::ABS_OIL] + d_oil;
-            x[ix::ABS_PGAS] = x0[ix::ABS_PGAS]
+            seg.x[ix::ABS_Q] = q1;
+            seg.x[ix::ABS_OIL] = x0[ix::ABS_OIL] + d_oil;
+            seg.x[ix::ABS_PGAS] = x0[ix::ABS_PGAS]
                 * gas_growth(
                     d_oil,
                     x0[ix::ABS_OIL],
                     a.gas.shell_volume_m3,
                     a.gas.exponent,
+                    &self.exp.gas[0],
                 );
         }
         if key.free {
             let (am, cm) = (c.area_m2 / c.mass_kg, c.viscous / c.mass_kg);
             let dv = |y: &[f64; 4], t: f64| am * (y[0] - y[2]) - cm * y[3] + forcing(3, t);
-            x[ix::V] = y1[3];
-            x[ix::X] = x0[ix::X] + hermite(y0[3], y1[3], dv(&y0, 0.0), dv(&y1, tau));
+            seg.x[ix::V] = y1[3];
+            seg.x[ix::X] = x0[ix::X] + hermite(y0[3], y1[3], dv(&y0, 0.0), dv(&y1, tau));
         }
         let d_fill = int(g0.q_fill, g1.q_fill, g2.q_fill);
-        x[ix::FILL_OIL] = x0[ix::FILL_OIL] + d_fill;
+        seg.x[ix::FILL_OIL] = x0[ix::FILL_OIL] + d_fill;
         let fill = &self.fill_gas;
-        x[ix::FILL_PGAS] = x0[ix::FILL_PGAS]
+        seg.x[ix::FILL_PGAS] = x0[ix::FILL_PGAS]
             * gas_growth(
                 d_fill,
                 x0[ix::FILL_OIL],
                 fill.shell_volume_m3,
                 fill.exponent,
+                &self.exp.gas[1],
             );
-        seg.x = x;
         seg
     }
 
@@ -257,18 +257,43 @@ impl Plant {
     }
 }
 
-/// The factor p_1/p_0 of a polytropic gas of exponent `n` in a shell of `shell` whose oil
-/// goes from `oil` to `oil + d_oil`: (V_g/(V_g − ΔV))ⁿ with V_g floored at a thousandth of the
-/// shell, by its binomial series for small changes (exact to rounding below 1e-3 of V_g). [1]
-fn gas_growth(d_oil: f64, oil: f64, shell: f64, n: f64) -> f64 {
-    let vg = (shell - oil).max(1e-3 * shell);
-    let e = d_oil / vg;
-    if libm::fabs(e) < 1e-3 {
-        // (1 − e)^(−n) = Σ C(n + k − 1, k)·eᵏ
+/// The binomial coefficients C(n + k − 1, k), k = 2…5, of a gas's polytropic series
+/// (1 − e)^(−n) = 1 + n·e + Σ C(n + k − 1, k)·eᵏ, for the exponent `n` they were taken at.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct GasSeries {
+    /// The polytropic exponent. [1]
+    n: f64,
+    /// C(n + 1, 2) … C(n + 4, 5). [1]
+    c: [f64; 4],
+}
+
+impl GasSeries {
+    /// The coefficients for exponent `n`.
+    pub(super) fn new(n: f64) -> GasSeries {
         let c2 = n * (n + 1.0) / 2.0;
         let c3 = c2 * (n + 2.0) / 3.0;
         let c4 = c3 * (n + 3.0) / 4.0;
         let c5 = c4 * (n + 4.0) / 5.0;
+        GasSeries {
+            n,
+            c: [c2, c3, c4, c5],
+        }
+    }
+}
+
+/// The factor p_1/p_0 of a polytropic gas of exponent `n` in a shell of `shell` whose oil
+/// goes from `oil` to `oil + d_oil`: (V_g/(V_g − ΔV))ⁿ with V_g floored at a thousandth of the
+/// shell, by its binomial series for small changes (exact to rounding below 1e-3 of V_g;
+/// `kept` its coefficients when taken at `n`). [1]
+fn gas_growth(d_oil: f64, oil: f64, shell: f64, n: f64, kept: &GasSeries) -> f64 {
+    let vg = (shell - oil).max(1e-3 * shell);
+    let e = d_oil / vg;
+    if libm::fabs(e) < 1e-3 {
+        let [c2, c3, c4, c5] = if kept.n == n {
+            kept.c
+        } else {
+            GasSeries::new(n).c
+        };
         1.0 + e * (n + e * (c2 + e * (c3 + e * (c4 + e * c5))))
     } else {
         let after = (shell - oil - d_oil).max(1e-3 * shell);

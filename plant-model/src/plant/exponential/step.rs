@@ -41,7 +41,7 @@ impl Plant {
                 enabled,
             };
             let poly = self.exp.poly();
-            let (seg, g1, used, mid) = self.exp_full_segment(&start, poly, remaining);
+            let (seg, g1, restart) = self.exp_full_segment(&start, poly.as_ref(), remaining);
             let e1 = self.exp_events(&seg.x, &g1, inputs, port, &x0);
             let mut first: Option<(usize, f64)> = None;
             for k in 0..EVENTS {
@@ -53,9 +53,14 @@ impl Plant {
                 }
             }
             let Some((k, f_guess)) = first else {
+                let mid = restart.as_ref().map(|r| &r.mid);
                 self.exp_commit(&start, &seg, g1, remaining, mid);
                 self.exp_project(inputs, &g1);
                 return;
+            };
+            let used = match restart {
+                Some(r) => r.poly,
+                None => poly.unwrap_or_default(),
             };
             let hi = self.locate(&start, &used, remaining, k, (e0[k], e1[k]), f_guess);
             let tau = hi * remaining;
@@ -85,7 +90,8 @@ impl Plant {
             key,
             enabled,
         };
-        let (seg, g1, _, mid) = self.exp_full_segment(&start, None, remaining);
+        let (seg, g1, restart) = self.exp_full_segment(&start, None, remaining);
+        let mid = restart.as_ref().map(|r| &r.mid);
         self.exp_commit(&start, &seg, g1, remaining, mid);
         self.exp_project(inputs, &g1);
     }
@@ -93,17 +99,18 @@ impl Plant {
     /// The segment of `tau` with the extrapolation `poly`, or, without one (a restart),
     /// Kutta's third-order stages: the rates at the half step predicted with the start's,
     /// then at the end predicted with 2·g(τ/2) − g(0), and the quadratic through the three.
-    /// Returns the end, its rates, the extrapolation used, and for a restart the rates at
-    /// the half step taken on the final trajectory (the history's middle point).
+    /// Returns the end, its rates, and for a restart the extrapolation it took with the
+    /// rates at the half step on the final trajectory (the history's middle point).
     #[inline(always)]
     pub(super) fn exp_full_segment(
         &self,
         start: &Start,
-        poly: Option<Poly>,
+        poly: Option<&Poly>,
         tau: f64,
-    ) -> (Segment, Rates, Poly, Option<Rates>) {
-        let (used, restart) = match poly {
-            Some(p) => (p, false),
+    ) -> (Segment, Rates, Option<Restart>) {
+        let taken;
+        let used = match poly {
+            Some(p) => p,
             None => {
                 let rates_at = |poly: &Poly, t: f64| {
                     let seg = self.exp_segment(start, poly, t);
@@ -118,16 +125,20 @@ impl Plant {
                     },
                     tau,
                 );
-                (quadratic(g0, &ga, &gb, tau), true)
+                taken = quadratic(g0, &ga, &gb, tau);
+                &taken
             }
         };
-        let seg = self.exp_segment(start, &used, tau);
+        let seg = self.exp_segment(start, used, tau);
         let g1 = self.exp_rates(&seg.x, &seg.at, start.enabled, start.key.k);
-        let mid = restart.then(|| {
-            let half = self.exp_segment(start, &used, 0.5 * tau);
-            self.exp_rates(&half.x, &half.at, start.enabled, start.key.k)
+        let restart = poly.is_none().then(|| {
+            let half = self.exp_segment(start, used, 0.5 * tau);
+            Restart {
+                poly: *used,
+                mid: self.exp_rates(&half.x, &half.at, start.enabled, start.key.k),
+            }
         });
-        (seg, g1, used, mid)
+        (seg, g1, restart)
     }
 
     /// The fraction of the segment at which event `k` has just happened, by the Illinois
@@ -197,11 +208,12 @@ impl Plant {
         seg: &Segment,
         mut g1: Rates,
         tau: f64,
-        mid: Option<Rates>,
+        mid: Option<&Rates>,
     ) {
         let at1 = seg.at;
         let (x0, g0, inputs) = (start.x, start.g, start.inputs);
-        let mut x = seg.x;
+        self.x = seg.x;
+        let x = &mut self.x;
         let (d_theta, d_x) = (x[ix::THETA] - x0[ix::THETA], x[ix::X] - x0[ix::X]);
         x[ix::E_IN] += seg.e_in;
         x[ix::E_CU] += seg.e_cu;
@@ -210,7 +222,6 @@ impl Plant {
             + self.piston_friction.force(self.discrete.piston) * d_x;
         x[ix::E_HYD] += seg.hyd_loss;
         x[ix::E_EXT] += -inputs.external_force_n * d_x - inputs.external_torque_nm * d_theta;
-        self.x = x;
         let theta = x[ix::THETA];
         if self.rotor.rotations >= ROTOR_RESYNC_STEPS {
             // The phasor taken afresh from the angle moves the angle terms by rounding: the
@@ -229,8 +240,8 @@ impl Plant {
         match mid {
             Some(gm) => {
                 self.exp.reset();
-                self.exp.push(g0, &gm, 0.5 * tau);
-                self.exp.push(&gm, &g1, 0.5 * tau);
+                self.exp.push(g0, gm, 0.5 * tau);
+                self.exp.push(gm, &g1, 0.5 * tau);
             }
             None => self.exp.push(g0, &g1, tau),
         }
@@ -240,4 +251,11 @@ impl Plant {
             key: start.key,
         });
     }
+}
+
+/// What a restarting segment took: the extrapolation through Kutta's stages and the rates
+/// at its half step.
+pub(super) struct Restart {
+    pub(super) poly: Poly,
+    pub(super) mid: Rates,
 }

@@ -7,9 +7,10 @@
 use super::super::actuator::Plant;
 use super::super::integrator::{EVENT_REFINEMENTS, EVENT_TOLERANCE};
 use super::super::state::{ix, AngleTerms, Vector};
-use super::blocks::{mv, winding_series, Winding, WindingStart, M2};
+use super::blocks::{mv, M2};
 use super::history::Poly;
 use super::rates::Rates;
+use super::series::{winding_series, winding_series_fixed, Winding, WindingStart};
 use crate::inverter::{dq_to_abc, pole_to_dq};
 use crate::motor::Phasor;
 
@@ -187,13 +188,22 @@ impl Plant {
                 coupling,
                 inv_l,
             };
+            // The band's resistance turns with the rotor only while a phase is inside it.
+            let turning = inside.iter().any(|k| *k);
+            let series = |d: f64| {
+                if turning {
+                    winding_series(&w, &start, d)
+                } else {
+                    winding_series_fixed(&w, &start, d)
+                }
+            };
             let speed = libm::fabs(omega_e) + libm::fabs(alpha_e) * (tau - t0);
             let nu = wc.nu_r + speed * wc.nu_w;
             let left = tau - t0;
             let mut delta = left
                 .min(WINDING_SPAN / nu.max(1e-300))
                 .max(tau / MAX_WINDING_PIECES);
-            let mut pts = winding_series(&w, &start, delta);
+            let mut pts = series(delta);
             if dead && cuts > 0 {
                 let start_m = margins(e, i, &inside);
                 let watched = start_m.map(|m| m > 0.0);
@@ -209,7 +219,7 @@ impl Plant {
                         if hi.0 - lo.0 <= EVENT_TOLERANCE {
                             break;
                         }
-                        let trial = winding_series(&w, &start, fr * delta);
+                        let trial = series(fr * delta);
                         let turned_e = e * Phasor::small(trial.turned[1]);
                         let v = margin(margins(turned_e, trial.i[1], &inside), &watched);
                         if v > 0.0 {
@@ -229,7 +239,7 @@ impl Plant {
                     }
                     if hi.0 < 1.0 {
                         delta *= hi.0;
-                        pts = winding_series(&w, &start, delta);
+                        pts = series(delta);
                         cuts -= 1;
                     }
                 }
@@ -317,7 +327,7 @@ impl Plant {
             accel_load: shaft.load,
             emf: [g0.emf, g1.emf, g2.emf],
         };
-        let pts = winding_series(&w, &start, tau);
+        let pts = winding_series_fixed(&w, &start, tau);
         let dl = m.l_d_h - m.l_q_h;
         let harmonic = f.d_slope_wb != 0.0 || f.q_slope_wb != 0.0;
         let point = |dth: f64, i: [f64; 2], u: [f64; 2]| {
