@@ -5,8 +5,8 @@
 //! polytropic series.
 
 use super::blocks::Phi;
+use super::gas::GasSeries;
 use super::rates::Rates;
-use super::segment::GasSeries;
 
 /// What the integrator carries from step to step.
 #[derive(Clone, Debug, Default)]

@@ -86,6 +86,7 @@
 mod blocks;
 mod events;
 mod explicit;
+mod gas;
 mod history;
 mod hydro_block;
 mod rates;
