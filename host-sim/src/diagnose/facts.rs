@@ -167,9 +167,10 @@ impl LogFacts {
         let low_side_apart = low_side_apart(log, fill_low_pa);
         let fill_pa = match log.p_low_pa.as_deref() {
             // A blocked cylinder's low side pressurised by the reversing pump is never at
-            // the fill while the port is: the rig file's level.
+            // the fill while the port is sucked down to it: the port's lowest reading,
+            // which the check valve's floor cannot lie above.
             Some(_) if low_side_apart && !moves(log) => {
-                rig.fill.pressure_pa - rig.fill.check_cracking_pa
+                log.p_pa.iter().copied().fold(f64::INFINITY, f64::min)
             }
             Some(pl) => {
                 let mut lower: Vec<f64> = log.p_pa.iter().zip(pl).map(|(a, b)| a.min(*b)).collect();
