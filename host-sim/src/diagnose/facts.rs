@@ -165,11 +165,19 @@ impl LogFacts {
         let fill_low_pa = rig.fill.pressure_pa;
         let p_low = LowSide::of(log, fill_low_pa);
         let low_side_apart = low_side_apart(log, fill_low_pa);
+        let piston_moves = log.x_m.as_deref().is_some_and(|x| {
+            let (lo, hi) = x
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                    (l.min(*v), h.max(*v))
+                });
+            hi - lo > MOVING_PISTON_TRAVEL_M
+        });
         let fill_pa = match log.p_low_pa.as_deref() {
             // A blocked cylinder's low side pressurised by the reversing pump is never at
             // the fill while the port is sucked down to it: the port's lowest reading,
             // which the check valve's floor cannot lie above.
-            Some(_) if low_side_apart && !moves(log) => {
+            Some(_) if low_side_apart && !piston_moves => {
                 log.p_pa.iter().copied().fold(f64::INFINITY, f64::min)
             }
             Some(pl) => {
@@ -179,7 +187,6 @@ impl LogFacts {
             }
             None => rig.fill.pressure_pa - rig.fill.check_cracking_pa,
         };
-        let piston_moves = moves(log);
         let x_smooth_m =
             log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
                 savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
@@ -507,18 +514,6 @@ pub fn unseen_piston_motion(log: &BenchLog, p_low: LowSide<'_>, rig: &Rig) -> bo
     displaced > 2.0 * (compression + absorber + leaked) + 1e-6
 }
 
-/// Whether `log`'s piston travels more than [`MOVING_PISTON_TRAVEL_M`] (`x_m` logged).
-fn moves(log: &BenchLog) -> bool {
-    log.x_m.as_deref().is_some_and(|x| {
-        let (lo, hi) = x
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-                (l.min(*v), h.max(*v))
-            });
-        hi - lo > MOVING_PISTON_TRAVEL_M
-    })
-}
-
 /// How far the logged low side must depart from the fill pressure, on at least
 /// [`APART_SHARE`] of the rows, for the leakage's two paths to be told apart. [Pa]
 pub const LOW_SIDE_APART_PA: f64 = 1e6;
@@ -543,6 +538,52 @@ pub fn low_side_apart(log: &BenchLog, fill: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A blocked cylinder's 1 kHz log at 3 MPa, its low side at `low` row by row.
+    fn blocked_log(low: Vec<f64>) -> BenchLog {
+        let n = low.len();
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
+        let mut p = vec![3e6; n];
+        p[n / 2] = 0.52e6;
+        BenchLog {
+            t_s: t.clone(),
+            p_ref_pa: vec![3e6; n],
+            p_pa: p,
+            speed_rad_s: vec![1.0; n],
+            iq_a: vec![0.5; n],
+            id_a: vec![0.0; n],
+            theta_m_rad: Some(t),
+            p_low_pa: Some(low),
+            ..BenchLog::default()
+        }
+    }
+
+    #[test]
+    fn a_low_side_two_megapascals_up_on_a_twentieth_of_the_rows_is_apart() {
+        // The nominal rig fills at 0.5 MPa: 100 of 2000 rows at 2.5 MPa are 5 % of the
+        // rows 2 MPa away; 10 of them (0.5 %) are not enough, nor is 1.4 MPa (0.9 MPa away).
+        let rig = Rig::nominal();
+        let with = |rows: usize, level: f64| {
+            let mut low = vec![0.5e6; 2000];
+            low[..rows].fill(level);
+            blocked_log(low)
+        };
+        assert!(LogFacts::of(&with(100, 2.5e6), &rig).low_side_apart);
+        assert!(!LogFacts::of(&with(10, 2.5e6), &rig).low_side_apart);
+        assert!(!LogFacts::of(&with(100, 1.4e6), &rig).low_side_apart);
+        assert!(!LogFacts::of(&with(0, 0.5e6), &rig).low_side_apart);
+    }
+
+    #[test]
+    fn a_pressurised_low_side_floors_the_port_at_its_lowest_reading() {
+        // The port dips once to 0.52 MPa while the low side sits at 2.5 MPa: its check
+        // valve cannot hold it above that; at the fill the median of the lower port is it.
+        let rig = Rig::nominal();
+        let apart = LogFacts::of(&blocked_log(vec![2.5e6; 2000]), &rig);
+        assert_eq!(apart.fill_pa, 0.52e6);
+        let at_fill = LogFacts::of(&blocked_log(vec![0.5e6; 2000]), &rig);
+        assert_eq!(at_fill.fill_pa, 0.5e6);
+    }
 
     #[test]
     fn unwrapping_restores_a_steady_rotation() {

@@ -91,6 +91,7 @@ impl HydraulicParams {
         let a = &rig.absorber;
         let port_to_port =
             rig.pump.internal_leakage_m3_s_pa + rig.cylinder.internal_leakage_m3_s_pa;
+        let leakage = nominal_leakage(rig);
         HydraulicParams {
             displacement_m3_per_rev: rig.pump.displacement_m3_per_rev,
             high_side_volume_m3: rig.cylinder.chamber_a_volume_m3,
@@ -103,13 +104,13 @@ impl HydraulicParams {
             }),
             inlet_inertance_kg_m4: a.inlet_inertance_kg_m4,
             inlet_resistance_pa_s_m3: a.inlet_resistance_pa_s_m3,
-            leakage_m3_s_pa: nominal_leakage(rig),
-            port_to_port_share: if nominal_leakage(rig) > 0.0 {
-                port_to_port / nominal_leakage(rig)
+            leakage_m3_s_pa: leakage,
+            port_to_port_share: if leakage > 0.0 {
+                port_to_port / leakage
             } else {
                 0.0
             },
-            leakage_top_m3_s_pa: nominal_leakage(rig) * LEAKAGE_BAND.1,
+            leakage_top_m3_s_pa: leakage * LEAKAGE_BAND.1,
             sensor_gain: 1.0,
             sensor_offset_pa: rig.sensors.pressure.offset_pa,
             sensor_lag_s: rig.sensors.pressure.lag_time_constant_s,
@@ -235,6 +236,8 @@ fn line_start(t: &[f64], y: &[f64]) -> (f64, f64) {
 pub struct Hydraulics {
     params: HydraulicParams,
     pump: Pump,
+    /// The leakage's port-to-port part G_pp. [(m³/s)/Pa]
+    port_to_port: f64,
 }
 
 impl Hydraulics {
@@ -244,8 +247,10 @@ impl Hydraulics {
         pp.pistons = params.ripple.0.max(1);
         pp.piston_ripple = params.ripple.1 > 0.0;
         pp.ripple_amplitude_ratio = params.ripple.1;
+        let g = params.leakage_m3_s_pa;
         Hydraulics {
             pump: Pump::new(&pp),
+            port_to_port: params.port_to_port_share * g.min(params.leakage_top_m3_s_pa),
             params,
         }
     }
@@ -407,7 +412,7 @@ impl Hydraulics {
         let [q_in, p_low, p_case, floor] = flows;
         let hp = &self.params;
         let g = hp.leakage_m3_s_pa;
-        let g_pp = hp.port_to_port_share * g.min(hp.leakage_top_m3_s_pa);
+        let g_pp = self.port_to_port;
         let rhs = c_oil * st.p + h * q_in + h * (g_pp * p_low + (g - g_pp) * p_case);
         let diag = c_oil + h * g;
         let mut p_new = rhs / diag;

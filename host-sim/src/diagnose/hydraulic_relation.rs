@@ -200,20 +200,6 @@ pub struct HydraulicRelation<'a> {
     pub facts: &'a LogFacts,
     /// The rig file.
     pub rig: &'a Rig,
-    /// Whether the leakage's port-to-port share is fitted ([`LogFacts::low_side_apart`]).
-    pub split: bool,
-}
-
-impl<'a> HydraulicRelation<'a> {
-    /// The relation of `log` with its `facts` on `rig`.
-    pub fn of(log: &'a BenchLog, facts: &'a LogFacts, rig: &'a Rig) -> HydraulicRelation<'a> {
-        HydraulicRelation {
-            log,
-            facts,
-            rig,
-            split: facts.low_side_apart,
-        }
-    }
 }
 
 /// Closest ratio of two shooting-window start pressures between which the precharge grid
@@ -265,7 +251,7 @@ impl Relation for HydraulicRelation<'_> {
         self.facts
     }
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
-        hydraulic_specs(self.rig, release, self.split)
+        hydraulic_specs(self.rig, release, self.facts.low_side_apart)
     }
 
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {

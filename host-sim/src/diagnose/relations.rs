@@ -81,7 +81,7 @@ impl<'a> Relations<'a> {
                 &log.speed_rad_s,
             ),
             m_val: windows(facts.validation(), MECHANICAL_WINDOW_S, &log.speed_rad_s),
-            hydraulic: HydraulicRelation::of(log, facts, rig),
+            hydraulic: HydraulicRelation { log, facts, rig },
             mechanical: MechanicalRelation::new(log, facts, motion, rig, &orders),
             electrical: ElectricalRelation::of(log, facts, rig),
             cylinder: CylinderRelation::of(log, facts, rig),

@@ -84,7 +84,11 @@ fn a_precharge_below_the_starting_pressure_is_found_from_the_rig_files_values() 
     let rig = Rig::nominal();
     let log = precharge_log(&rig);
     let facts = LogFacts::of(&log, &rig);
-    let relation = HydraulicRelation::of(&log, &facts, &rig);
+    let relation = HydraulicRelation {
+        log: &log,
+        facts: &facts,
+        rig: &rig,
+    };
     let rows = thinned(
         facts.windows(facts.identification(), HYDRAULIC_WINDOW_S),
         &log.p_pa,
