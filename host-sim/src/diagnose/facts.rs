@@ -1,12 +1,13 @@
 //! Facts about a bench log, computed once before any model runs: its sampling, the shaft
 //! angle (logged, else integrated from the logged speed), the low-side pressure (logged,
-//! else the rig's fill pressure), whether the piston moves, each signal's noise level, the
+//! else estimated where the q current shows it pressurised, else the rig's fill pressure), whether the piston moves, each signal's noise level, the
 //! identification and validation segments, and the stretches of steady rotation where
 //! angle-locked lines can be measured.
 //!
 //! Every later stage reads these instead of asking the log again.
 
 use crate::bench_log::{BenchLog, Signal};
+use crate::diagnose::low_side;
 use plant_model::Rig;
 use std::f64::consts::PI;
 use std::ops::Range;
@@ -89,9 +90,14 @@ pub struct LogFacts {
     pub fill_pa: f64,
     /// Whether the piston moves (`x_m` logged and travelling).
     pub piston_moves: bool,
-    /// Whether the logged low side departs from the fill ([`low_side_apart`]): a pump
-    /// reversing into a blocked cylinder's low side pressurises it.
+    /// Whether the low side (logged or estimated) departs from the fill
+    /// ([`low_side::apart`]): a pump reversing into a blocked cylinder's low side
+    /// pressurises it.
     pub low_side_apart: bool,
+    /// The low side's pressure where the log does not hold it but the q current shows it
+    /// pressurised: port B's node integrated from the pump's displaced volume
+    /// ([`crate::diagnose::low_side`]). [Pa]
+    pub p_low_estimate: Option<Vec<f64>>,
     /// The logged piston position smoothed over ±[`POSITION_SMOOTHING_S`] (quadratic
     /// Savitzky–Golay), when the piston moves: the volume balance multiplies the position by
     /// the oil's stiffness A·β/V, 14 kPa per micrometre of a 71 cm² piston, so the
@@ -144,10 +150,13 @@ impl<'a> LowSide<'a> {
 }
 
 impl LogFacts {
-    /// The low side's pressure of `log` (the log these facts are of): logged, or the rig's
-    /// fill pressure. [Pa]
-    pub fn p_low<'a>(&self, log: &'a BenchLog) -> LowSide<'a> {
-        LowSide::of(log, self.fill_low_pa)
+    /// The low side's pressure of `log` (the log these facts are of): logged, estimated
+    /// ([`LogFacts::p_low_estimate`]), or the rig's fill pressure. [Pa]
+    pub fn p_low<'a>(&'a self, log: &'a BenchLog) -> LowSide<'a> {
+        match &self.p_low_estimate {
+            Some(p) if log.p_low_pa.is_none() => LowSide::Logged(p),
+            _ => LowSide::of(log, self.fill_low_pa),
+        }
     }
 
     /// The facts of a checked `log` (at least a few rows, time increasing) on `rig`.
@@ -164,7 +173,6 @@ impl LogFacts {
         };
         let fill_low_pa = rig.fill.pressure_pa;
         let p_low = LowSide::of(log, fill_low_pa);
-        let low_side_apart = low_side_apart(log, fill_low_pa);
         let piston_moves = log.x_m.as_deref().is_some_and(|x| {
             let (lo, hi) = x
                 .iter()
@@ -173,7 +181,23 @@ impl LogFacts {
                 });
             hi - lo > MOVING_PISTON_TRAVEL_M
         });
-        let fill_pa = match log.p_low_pa.as_deref() {
+        let x_smooth_m =
+            log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
+                savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
+            });
+        let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, p_low, rig);
+        let split = segment_split(t, &theta_rad, period_s, rig);
+        let start = t
+            .partition_point(|x| *x < t[0] + START_SKIP_S)
+            .min(split / 4);
+        // A blocked cylinder's low side the log does not hold, pressurised where the q
+        // current says so.
+        let p_low_estimate = (!piston_moves && !piston_unseen)
+            .then(|| low_side::estimate(log, &theta_rad, None, rig, start..rows))
+            .flatten();
+        let low = log.p_low_pa.as_deref().or(p_low_estimate.as_deref());
+        let low_side_apart = low_side::apart(low, fill_low_pa);
+        let fill_pa = match low {
             // A blocked cylinder's low side pressurised by the reversing pump is never at
             // the fill while the port is sucked down to it: the port's lowest reading,
             // which the check valve's floor cannot lie above.
@@ -187,15 +211,6 @@ impl LogFacts {
             }
             None => rig.fill.pressure_pa - rig.fill.check_cracking_pa,
         };
-        let x_smooth_m =
-            log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
-                savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
-            });
-        let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, p_low, rig);
-        let split = segment_split(t, &theta_rad, period_s, rig);
-        let start = t
-            .partition_point(|x| *x < t[0] + START_SKIP_S)
-            .min(split / 4);
         let noise_rms = log
             .columns()
             .filter(|(s, _)| *s != Signal::Time)
@@ -222,6 +237,7 @@ impl LogFacts {
             fill_low_pa,
             fill_pa,
             low_side_apart,
+            p_low_estimate,
             piston_moves,
             x_smooth_m,
             piston_unseen,
@@ -512,27 +528,6 @@ pub fn unseen_piston_motion(log: &BenchLog, p_low: LowSide<'_>, rig: &Rig) -> bo
         0.0
     };
     displaced > 2.0 * (compression + absorber + leaked) + 1e-6
-}
-
-/// How far the logged low side must depart from the fill pressure, on at least
-/// [`APART_SHARE`] of the rows, for the leakage's two paths to be told apart. [Pa]
-pub const LOW_SIDE_APART_PA: f64 = 1e6;
-
-/// Share of the rows on which the low side must depart ([`LOW_SIDE_APART_PA`]). [1]
-pub const APART_SHARE: f64 = 0.01;
-
-/// Whether `log`'s low side departs from the `fill` pressure enough to tell the leakage's
-/// port-to-port path from its path to the case: logged, and [`LOW_SIDE_APART_PA`] away on
-/// [`APART_SHARE`] of the rows. Otherwise the low side and the case sit at the same
-/// level and the logged low side is the measurement of both.
-pub fn low_side_apart(log: &BenchLog, fill: f64) -> bool {
-    log.p_low_pa.as_deref().is_some_and(|p| {
-        let apart = p
-            .iter()
-            .filter(|v| (**v - fill).abs() > LOW_SIDE_APART_PA)
-            .count();
-        apart as f64 > APART_SHARE * p.len() as f64
-    })
 }
 
 #[cfg(test)]

@@ -49,6 +49,7 @@ pub mod hydraulic_relation;
 pub mod least_squares;
 pub mod lines;
 pub mod loop_response;
+pub mod low_side;
 pub mod mechanical;
 pub mod mechanical_relation;
 pub mod param_spec;
