@@ -7,7 +7,7 @@
 //! Every later stage reads these instead of asking the log again.
 
 use crate::bench_log::{BenchLog, Signal};
-use crate::diagnose::low_side;
+use crate::diagnose::{low_side, unseen_motion};
 use plant_model::Rig;
 use std::f64::consts::PI;
 use std::ops::Range;
@@ -104,7 +104,7 @@ pub struct LogFacts {
     /// transducer's noise would otherwise dominate the pressure it predicts. [m]
     pub x_smooth_m: Option<Vec<f64>>,
     /// Whether the piston moves but `x_m` is not logged: the pump displaced far more oil
-    /// than the high side can store and leak ([`unseen_piston_motion`]). The pressure's
+    /// than the high side can store and leak ([`unseen_motion::unseen_piston_motion`]). The pressure's
     /// volume balance then lacks its largest flow, and the hydraulic effects cannot be
     /// tested.
     pub piston_unseen: bool,
@@ -185,7 +185,8 @@ impl LogFacts {
             log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
                 savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
             });
-        let piston_unseen = log.x_m.is_none() && unseen_piston_motion(log, p_low, rig);
+        let piston_unseen =
+            log.x_m.is_none() && unseen_motion::unseen_piston_motion(log, p_low, rig);
         let split = segment_split(t, &theta_rad, period_s, rig);
         let start = t
             .partition_point(|x| *x < t[0] + START_SKIP_S)
@@ -497,37 +498,6 @@ fn steady_windows(t: &[f64], theta: &[f64], period_s: f64) -> Vec<SteadyWindow> 
         keep(s0..(start).min(n), &mut out);
     }
     out
-}
-
-/// Whether a log without the piston's position shows it moving: the oil the pump
-/// displaced, ∫ D/2π·|ω| dt, is more than twice what the high side could take — its
-/// oil's compression over the logged pressure range, the whole absorber shell if the
-/// pressure rose above its precharge, and twice the rig's leakage — plus a cubic
-/// centimetre. A blocked cylinder's pump only replaces leakage and compression. [m³]
-pub fn unseen_piston_motion(log: &BenchLog, p_low: LowSide<'_>, rig: &Rig) -> bool {
-    let d_per_rad = rig.pump.displacement_m3_per_rev / (2.0 * PI);
-    let leakage = rig.pump.internal_leakage_m3_s_pa
-        + rig.pump.external_leakage_m3_s_pa
-        + rig.cylinder.internal_leakage_m3_s_pa;
-    let (mut displaced, mut leaked) = (0.0, 0.0);
-    for k in 1..log.len() {
-        let dt = log.t_s[k] - log.t_s[k - 1];
-        displaced += d_per_rad * log.speed_rad_s[k].abs() * dt;
-        leaked += 2.0 * leakage * (log.p_pa[k] - p_low.at(k)).abs() * dt;
-    }
-    let (lo, hi) = log
-        .p_pa
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
-            (l.min(*p), h.max(*p))
-        });
-    let compression = rig.cylinder.chamber_a_volume_m3 / rig.oil.bulk_modulus_pa * (hi - lo);
-    let absorber = if rig.absorber.enabled && hi > rig.absorber.precharge_pa {
-        rig.absorber.shell_volume_m3
-    } else {
-        0.0
-    };
-    displaced > 2.0 * (compression + absorber + leaked) + 1e-6
 }
 
 #[cfg(test)]

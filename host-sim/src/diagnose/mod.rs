@@ -65,6 +65,7 @@ pub mod spectrum;
 pub mod stick;
 #[cfg(test)]
 mod test_noise;
+pub mod unseen_motion;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 
