@@ -7,6 +7,7 @@
 //! Every later stage reads these instead of asking the log again.
 
 use crate::bench_log::{BenchLog, Signal};
+pub use crate::diagnose::low_side::LowSide;
 use crate::diagnose::{low_side, unseen_motion};
 use plant_model::Rig;
 use std::f64::consts::PI;
@@ -118,35 +119,6 @@ pub struct LogFacts {
     /// Steady-rotation windows (speed nearly constant, at least
     /// [`STEADY_MIN_REVOLUTIONS`]), in time order, none across the segments' boundary.
     pub steady: Vec<SteadyWindow>,
-}
-
-/// The low side's (port B) pressure row by row: the logged column, or one level throughout
-/// (read where it is needed, never copied). [Pa]
-#[derive(Clone, Copy, Debug)]
-pub enum LowSide<'a> {
-    /// The log's `p_low_pa`.
-    Logged(&'a [f64]),
-    /// The same pressure at every row.
-    Level(f64),
-}
-
-impl<'a> LowSide<'a> {
-    /// The log's low side, or `level` where it is not logged.
-    pub fn of(log: &'a BenchLog, level: f64) -> LowSide<'a> {
-        match log.p_low_pa.as_deref() {
-            Some(p) => LowSide::Logged(p),
-            None => LowSide::Level(level),
-        }
-    }
-
-    /// The pressure at row `k`. [Pa]
-    #[inline]
-    pub fn at(&self, k: usize) -> f64 {
-        match self {
-            LowSide::Logged(p) => p[k],
-            LowSide::Level(p) => *p,
-        }
-    }
 }
 
 impl LogFacts {

@@ -28,11 +28,42 @@
 //! Chamber B's oil has the port's bulk modulus, which entrained air lowers: the node's β is
 //! the one whose pressure the q current's torque balance follows best (a one-dimensional
 //! golden-section search), so the estimate does not presume the oil it may be asked about.
+//!
+//! [`LowSide`] is how the relations read the low side row by row, logged or estimated.
 
 use crate::bench_log::BenchLog;
 use nalgebra::{SMatrix, SVector};
 use plant_model::Rig;
 use std::f64::consts::PI;
+
+/// The low side's (port B) pressure row by row: the logged column, or one level throughout
+/// (read where it is needed, never copied). [Pa]
+#[derive(Clone, Copy, Debug)]
+pub enum LowSide<'a> {
+    /// The log's `p_low_pa`.
+    Logged(&'a [f64]),
+    /// The same pressure at every row.
+    Level(f64),
+}
+
+impl<'a> LowSide<'a> {
+    /// The log's low side, or `level` where it is not logged.
+    pub fn of(log: &'a BenchLog, level: f64) -> LowSide<'a> {
+        match log.p_low_pa.as_deref() {
+            Some(p) => LowSide::Logged(p),
+            None => LowSide::Level(level),
+        }
+    }
+
+    /// The pressure at row `k`. [Pa]
+    #[inline]
+    pub fn at(&self, k: usize) -> f64 {
+        match self {
+            LowSide::Logged(p) => p[k],
+            LowSide::Level(p) => *p,
+        }
+    }
+}
 
 /// How much smaller the current's residual must be with the integrated low side than with
 /// the fill for the log to be read as a pressurised low side. The rest of the residual is

@@ -2,7 +2,7 @@
 //! the high side (eq. 9–11 bounded, not solved) over the oil the pump displaced.
 
 use crate::bench_log::BenchLog;
-use crate::diagnose::facts::LowSide;
+use crate::diagnose::low_side::LowSide;
 use plant_model::Rig;
 use std::f64::consts::PI;
 
