@@ -175,9 +175,10 @@ impl LogFacts {
             // the fill while the port is sucked down to it: the port's lowest reading,
             // which the check valve's floor cannot lie above (from the first row scored: the
             // logger's first rows may hold a reading from before the rig settled).
-            Some(_) if low_side_apart && !piston_moves => {
-                log.p_pa[start..].iter().copied().fold(f64::INFINITY, f64::min)
-            }
+            Some(_) if low_side_apart && !piston_moves => log.p_pa[start..]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
             Some(pl) => {
                 let mut lower: Vec<f64> = log.p_pa.iter().zip(pl).map(|(a, b)| a.min(*b)).collect();
                 lower.sort_by(f64::total_cmp);

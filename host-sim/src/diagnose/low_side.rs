@@ -19,9 +19,9 @@
 //! ```
 //!
 //! G_pp the port-to-port leakage (the pump's internal and the cylinder's cross-piston), G_ext
-//! the pump's external leakage from port B to the case, p_f the fill. The check valve from
-//! the fill holds p_low above the fill less its cracking; the relief valve holds it below
-//! the fill plus its cracking (both conductances are large: their levels are bounds). Each
+//! the pump's external leakage from port B to the case, p_f the fill. The check valve feeds
+//! B from the fill below the fill less its cracking, the relief valve drains it to the fill
+//! above the fill plus its cracking, each with the rig file's conductance. Each
 //! interval is one backward-Euler step, closed form: the pump's term is a displaced volume,
 //! exact over the interval, and the leakage's time constant is seconds.
 //!
