@@ -1,8 +1,9 @@
 //! Facts about a bench log, computed once before any model runs: its sampling, the shaft
 //! angle (logged, else integrated from the logged speed), the low-side pressure (logged,
-//! else estimated where the q current shows it pressurised, else the rig's fill pressure), whether the piston moves, each signal's noise level, the
-//! identification and validation segments, and the stretches of steady rotation where
-//! angle-locked lines can be measured.
+//! else estimated where the q current shows it pressurised, else the rig's fill
+//! pressure), whether the piston moves, each signal's noise level, the identification and
+//! validation segments, and the stretches of steady rotation where angle-locked lines can
+//! be measured.
 //!
 //! Every later stage reads these instead of asking the log again.
 
