@@ -105,10 +105,10 @@ pub struct LogFacts {
     /// the oil's stiffness A·β/V, 14 kPa per micrometre of a 71 cm² piston, so the
     /// transducer's noise would otherwise dominate the pressure it predicts. [m]
     pub x_smooth_m: Option<Vec<f64>>,
-    /// Whether the piston moves but `x_m` is not logged: the pump displaced far more oil
-    /// than the high side can store and leak ([`unseen_motion::unseen_piston_motion`]). The pressure's
-    /// volume balance then lacks its largest flow, and the hydraulic effects cannot be
-    /// tested.
+    /// Whether the piston moves but `x_m` is not logged: the oil the pump displaced swings
+    /// over far more than the high side can store and leak
+    /// ([`unseen_motion::unseen_piston_motion`]). The pressure's volume balance then lacks
+    /// its largest flow, and the hydraulic effects cannot be tested.
     pub piston_unseen: bool,
     /// First row of the validation segment (identification is `start..split`).
     pub split: usize,
