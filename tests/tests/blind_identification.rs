@@ -53,9 +53,8 @@ use tests::blind::{
 const CI_SEEDS: [u64; 4] = [9, 14, 31, 35];
 
 /// Seeds of the CI part the diagnosis gets wrong today: the suite reports them
-/// and fails when one of them is right (take it out) or any other seed fails.
-/// - 31, sine, entrained air + dead time: only the dead time named.
-const KNOWN_MISSES: [u64; 1] = [31];
+/// and fails when one of them is right (take it out) or any other seed fails. None today.
+const KNOWN_MISSES: [u64; 0] = [];
 
 /// Least validation-fit gain on a hidden effect's signal. [points]
 const MIN_FIT_GAIN: f64 = 0.0;

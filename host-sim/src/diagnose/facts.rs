@@ -173,13 +173,10 @@ impl LogFacts {
         let low_side_apart = low_side::apart(low, fill_low_pa);
         let fill_pa = match low {
             // A blocked cylinder's low side pressurised by the reversing pump is never at
-            // the fill while the port is sucked down to it: the port's lowest reading,
-            // which the check valve's floor cannot lie above (from the first row scored: the
-            // logger's first rows may hold a reading from before the rig settled).
-            Some(_) if low_side_apart && !piston_moves => log.p_pa[start..]
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min),
+            // the fill while the port is sucked down to it: the level the port holds there.
+            Some(_) if low_side_apart && !piston_moves => {
+                low_side::sucked_port_level(log, start, period_s, noise_rms(&log.p_pa))
+            }
             Some(pl) => {
                 let mut lower: Vec<f64> = log.p_pa.iter().zip(pl).map(|(a, b)| a.min(*b)).collect();
                 lower.sort_by(f64::total_cmp);
