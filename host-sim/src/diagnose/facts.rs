@@ -169,13 +169,22 @@ impl LogFacts {
         let p_low_estimate = (!piston_moves && !piston_unseen)
             .then(|| low_side::estimate(log, &theta_rad, None, rig, start..rows))
             .flatten();
+        let noise_rms: Vec<(Signal, f64)> = log
+            .columns()
+            .filter(|(s, _)| *s != Signal::Time)
+            .map(|(s, y)| (s, noise_rms(y)))
+            .collect();
+        let p_noise = noise_rms
+            .iter()
+            .find(|(s, _)| *s == Signal::Pressure)
+            .map_or(0.0, |(_, v)| *v);
         let low = log.p_low_pa.as_deref().or(p_low_estimate.as_deref());
         let low_side_apart = low_side::apart(low, fill_low_pa);
         let fill_pa = match low {
             // A blocked cylinder's low side pressurised by the reversing pump is never at
             // the fill while the port is sucked down to it: the level the port holds there.
             Some(_) if low_side_apart && !piston_moves => {
-                low_side::sucked_port_level(log, start, period_s, noise_rms(&log.p_pa))
+                low_side::sucked_port_level(log, start, period_s, p_noise)
             }
             Some(pl) => {
                 let mut lower: Vec<f64> = log.p_pa.iter().zip(pl).map(|(a, b)| a.min(*b)).collect();
@@ -184,11 +193,6 @@ impl LogFacts {
             }
             None => rig.fill.pressure_pa - rig.fill.check_cracking_pa,
         };
-        let noise_rms = log
-            .columns()
-            .filter(|(s, _)| *s != Signal::Time)
-            .map(|(s, y)| (s, noise_rms(y)))
-            .collect();
         let mut steady = steady_windows(&t[..split], &theta_rad[..split], period_s)
             .into_iter()
             .filter(|w| w.rows.start >= start)
