@@ -277,6 +277,7 @@ pub fn analyse_reporting(
     let (named, hydraulic_values) = select(&rel, &mut tested, rig, displacement);
     // The line bases served the fits; the predictions do not read them.
     rel.mechanical.forget_bases();
+    crate::memory::return_freed_memory();
     // 6. Predictions and scores.
     let ctx = Context {
         log,

@@ -10,6 +10,7 @@ use crate::diagnose::hydraulic::{HydraulicInputs, HydraulicParams, Hydraulics, L
 use crate::diagnose::least_squares::{huber, ParamSpec};
 use plant_model::accumulator::GasCharge;
 use plant_model::Rig;
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// Upper end of the transducer lag's tolerance band: a transducer with its snubber and
@@ -181,14 +182,23 @@ pub fn hydraulic_residuals(
     let sigma = facts.noise(Signal::Pressure).unwrap_or(1.0).max(1.0);
     let model = Hydraulics::new(params, rig);
     let inputs = HydraulicInputs::of(log, facts);
-    let mut out = Vec::new();
-    let mut pred = Vec::new();
+    // The windows start afresh (multiple shooting): each is run on its own, in parallel,
+    // into its own stretch of the residuals, in the windows' order.
+    let mut out = vec![0.0; windows.iter().map(|w| w.len().saturating_sub(1)).sum()];
+    let mut stretches = Vec::with_capacity(windows.len());
+    let mut rest = out.as_mut_slice();
     for w in windows {
-        pred.clear();
-        pred.resize(w.len(), 0.0);
-        model.predict_window(&inputs, w.clone(), &mut pred);
-        out.extend((w.start + 1..w.end).map(|k| huber((log.p_pa[k] - pred[k - w.start]) / sigma)));
+        let (mine, others) = rest.split_at_mut(w.len().saturating_sub(1));
+        stretches.push((w, mine));
+        rest = others;
     }
+    stretches.into_par_iter().for_each(|(w, stretch)| {
+        let mut pred = vec![0.0; w.len()];
+        model.predict_window(&inputs, w.clone(), &mut pred);
+        for (k, r) in (w.start + 1..w.end).zip(stretch) {
+            *r = huber((log.p_pa[k] - pred[k - w.start]) / sigma);
+        }
+    });
     out
 }
 
