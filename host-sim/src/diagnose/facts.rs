@@ -174,10 +174,7 @@ impl LogFacts {
             .filter(|(s, _)| *s != Signal::Time)
             .map(|(s, y)| (s, noise_rms(y)))
             .collect();
-        let p_noise = noise_rms
-            .iter()
-            .find(|(s, _)| *s == Signal::Pressure)
-            .map_or(0.0, |(_, v)| *v);
+        let p_noise = noise_of(&noise_rms, Signal::Pressure).unwrap_or(0.0);
         let low = log.p_low_pa.as_deref().or(p_low_estimate.as_deref());
         let low_side_apart = low_side::apart(low, fill_low_pa);
         let fill_pa = match low {
@@ -227,10 +224,7 @@ impl LogFacts {
 
     /// The noise RMS of `signal` (its unit), if logged.
     pub fn noise(&self, signal: Signal) -> Option<f64> {
-        self.noise_rms
-            .iter()
-            .find(|(s, _)| *s == signal)
-            .map(|(_, v)| *v)
+        noise_of(&self.noise_rms, signal)
     }
 
     /// Identification rows.
@@ -367,6 +361,11 @@ fn median_period(t: &[f64]) -> f64 {
         .copied()
         .unwrap_or(1e-3)
         .max(f64::MIN_POSITIVE)
+}
+
+/// `signal`'s noise RMS in the per-signal list `noise`, if it lists it.
+fn noise_of(noise: &[(Signal, f64)], signal: Signal) -> Option<f64> {
+    noise.iter().find(|(s, _)| *s == signal).map(|(_, v)| *v)
 }
 
 /// Noise RMS of a signal from its second differences, which cancel any trend and slope:

@@ -276,12 +276,13 @@ pub const SUCKED_MIN_S: f64 = 0.1;
 /// under its threshold there). The lowest reading is the answer where the port is seen
 /// sucked for less than [`SUCKED_MIN_S`] at the log's `period_s`. [Pa]
 pub fn sucked_port_level(log: &BenchLog, start: usize, period_s: f64, noise_pa: f64) -> f64 {
-    let p = &log.p_pa[start.min(log.len())..];
+    let start = start.min(log.len());
+    let p = &log.p_pa[start..];
     let lowest = p.iter().copied().fold(f64::INFINITY, f64::min);
     let band = SUCKED_BAND_PA + 4.0 * noise_pa;
     let mut held: Vec<f64> = p
         .iter()
-        .zip(&log.speed_rad_s[start.min(log.len())..])
+        .zip(&log.speed_rad_s[start..])
         .filter(|(p, w)| **w < 0.0 && **p < lowest + band)
         .map(|(p, _)| *p)
         .collect();
