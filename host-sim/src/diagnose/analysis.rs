@@ -232,6 +232,8 @@ pub fn analyse_reporting(
     let motion = ShaftMotion::of(log, &facts, rig.motor.pole_pairs);
     let rel = Relations::of(log, &facts, &motion, rig, precision);
     progress.step("calibration");
+    // The fits' vectors reused from the heap, until the predictions.
+    let fit_stage = crate::memory::FitStage::begin();
     // 2. Calibration.
     let cal = calibrate_all(&rel, progress);
     // 3. Lines, read with the calibrated shaft.
@@ -277,7 +279,7 @@ pub fn analyse_reporting(
     let (named, hydraulic_values) = select(&rel, &mut tested, rig, displacement);
     // The line bases served the fits; the predictions do not read them.
     rel.mechanical.forget_bases();
-    crate::memory::return_freed_memory();
+    drop(fit_stage);
     // 6. Predictions and scores.
     let ctx = Context {
         log,
