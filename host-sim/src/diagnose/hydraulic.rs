@@ -232,6 +232,50 @@ fn line_start(t: &[f64], y: &[f64]) -> (f64, f64) {
     ((sy - slope * st) / nf, slope)
 }
 
+/// The transducer's step factors 1 − e^(−h/τ) of the last few substep lengths h met, each
+/// computed once. A logged time column's intervals differ in their last bits from row to
+/// row (times written to a tenth of a millisecond and read back: fifteen distinct
+/// intervals on a 2 kHz log, changing every other row), so one remembered length would
+/// miss on most rows; a handful, matched exactly, hits on nearly all, and every factor is
+/// the one computed for its own length.
+struct LagFactors {
+    /// Time constant τ. [s]
+    tau: f64,
+    /// Lengths h [s] and their factors [1]; unused slots hold NaN, which matches nothing.
+    seen: [(f64, f64); LagFactors::KEPT],
+    /// The slot the next new length takes.
+    next: usize,
+}
+
+impl LagFactors {
+    /// Lengths kept.
+    const KEPT: usize = 16;
+
+    fn new(tau: f64) -> LagFactors {
+        LagFactors {
+            tau,
+            seen: [(f64::NAN, 1.0); LagFactors::KEPT],
+            next: 0,
+        }
+    }
+
+    /// The factor of substep length `h`. [1]
+    #[inline]
+    fn at(&mut self, h: f64) -> f64 {
+        if let Some((_, f)) = self.seen.iter().find(|(seen, _)| *seen == h) {
+            return *f;
+        }
+        let f = if self.tau > 0.0 {
+            1.0 - (-h / self.tau).exp()
+        } else {
+            1.0
+        };
+        self.seen[self.next] = (h, f);
+        self.next = (self.next + 1) % LagFactors::KEPT;
+        f
+    }
+}
+
 /// A prepared model: the parameters with the pump's ripple tables built once.
 pub struct Hydraulics {
     params: HydraulicParams,
@@ -330,21 +374,14 @@ impl Hydraulics {
         // The check valve from the fill holds the port at the fill level: the transducer's
         // reading of it in true pressure.
         let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
-        // The transducer's step factor 1 − e^(−h/τ), recomputed only when h changes.
-        let mut lag = (f64::NAN, 1.0);
+        // The transducer's step factor 1 − e^(−h/τ) of each substep length met.
+        let mut lag = LagFactors::new(hp.sensor_lag_s);
         for k in rows.start..rows.end.saturating_sub(1) {
             let next = k + 1;
             let dt = x.t_s[next] - x.t_s[k];
             let steps = ((dt / MAX_SUBSTEP_S).ceil() as usize).max(1);
             let h = dt / steps as f64;
-            if h != lag.0 {
-                let f = if hp.sensor_lag_s > 0.0 {
-                    1.0 - (-h / hp.sensor_lag_s).exp()
-                } else {
-                    1.0
-                };
-                lag = (h, f);
-            }
+            let lag = lag.at(h);
             let dtheta = x.theta_rad[next] - x.theta_rad[k];
             let (x0, dx) = match x.x_m {
                 Some(xm) => (xm[k], xm[next] - xm[k]),
@@ -374,7 +411,7 @@ impl Hydraulics {
                     (q_at(factor), c_at(f))
                 };
                 for st in st.iter_mut() {
-                    self.substep(st, h, [q_in, p_low, p_case, floor], c_oil, lag.1);
+                    self.substep(st, h, [q_in, p_low, p_case, floor], c_oil, lag);
                 }
             }
             for (o, st) in out.iter_mut().zip(&st) {
