@@ -3,17 +3,18 @@
 //! to the system before the next stage allocates its own (`docs/memory.md`).
 
 /// Size from which glibc's allocator maps a block of its own, returned to the system when
-/// freed, outside the fits: a whole-log column, once freed, goes
-/// back to the system instead of staying in a fragmented heap. [B]
+/// freed, outside the fits: a whole-log column, once freed, goes back to the system instead
+/// of staying in a fragmented heap. [B]
 pub const MAPPED_FROM_B: usize = 128 * 1024;
 
-/// The same threshold while the diagnosis fits ([`FitStage`]): above a fit's
-/// per-evaluation residual vector (8 B a row over the 27 000 rows a fit reads at most,
-/// 12 s at one row per 0.45 ms; twice that once the priors' rows are appended), which the optimiser allocates and frees
-/// at every model run: from the heap it is reused, instead of mapped, faulted in page by
-/// page and unmapped (with the other cores' address translations flushed) each time. The
-/// Jacobians, a few times larger and allocated once an iteration, stay mapped: kept in the
-/// heap they raised the peak of a 120 s 1 kHz log's diagnosis past four times its file. [B]
+/// The same threshold while the diagnosis fits ([`FitStage`]): above a fit's per-evaluation
+/// residual vector (8 B a row over the 27 000 rows a fit reads at most, 12 s at one row per
+/// 0.45 ms; twice that once the priors' rows are appended), which the optimiser allocates
+/// and frees at every model run: from the heap it is reused, instead of mapped, faulted in
+/// page by page and unmapped (with the other cores' address translations flushed) each
+/// time. The Jacobians, a few times larger and allocated once an iteration, stay mapped:
+/// kept in the heap, their leftovers would add to the fits' peak, which on a short log
+/// written tersely is the process's (`docs/memory.md`). [B]
 pub const FIT_MAPPED_FROM_B: usize = 1024 * 1024;
 
 /// Fixes glibc's threshold for mapping a block of its own at `bytes`. By default the
@@ -42,8 +43,10 @@ pub fn large_blocks_mapped() {
 
 /// The diagnosis's fitting stage: from [`FitStage::begin`] until the value is dropped,
 /// blocks up to [`FIT_MAPPED_FROM_B`] come from the heap; when it ends, large blocks are
-/// mapped again and what the fits freed is handed back to the system
-/// ([`return_freed_memory`]), so that the next stage's peak is its own.
+/// mapped from [`MAPPED_FROM_B`] again and what the fits freed is handed back to the system
+/// ([`return_freed_memory`]), so that the next stage's peak is its own. The threshold is
+/// the process's: one that diagnoses in-process (a test, an example) keeps
+/// [`MAPPED_FROM_B`] afterwards, as `eha` has from its start.
 pub struct FitStage(());
 
 impl FitStage {

@@ -37,6 +37,7 @@
 //! filling at the slope.
 
 use crate::diagnose::facts::{rows_spanning, LogFacts, LowSide};
+use crate::diagnose::lag_factors::LagFactors;
 use plant_model::accumulator::{GasCharge, ATMOSPHERE_PA};
 use plant_model::pump::Pump;
 use plant_model::Rig;
@@ -230,50 +231,6 @@ fn line_start(t: &[f64], y: &[f64]) -> (f64, f64) {
     }
     let slope = (nf * sty - st * sy) / den;
     ((sy - slope * st) / nf, slope)
-}
-
-/// The transducer's step factors 1 − e^(−h/τ) of the last few substep lengths h met, each
-/// computed once. A logged time column's intervals differ in their last bits from row to
-/// row (times written to a tenth of a millisecond and read back: fifteen distinct
-/// intervals on a 2 kHz log, changing every other row), so one remembered length would
-/// miss on most rows; a handful, matched exactly, hits on nearly all, and every factor is
-/// the one computed for its own length.
-struct LagFactors {
-    /// Time constant τ. [s]
-    tau: f64,
-    /// Lengths h [s] and their factors [1]; unused slots hold NaN, which matches nothing.
-    seen: [(f64, f64); LagFactors::KEPT],
-    /// The slot the next new length takes.
-    next: usize,
-}
-
-impl LagFactors {
-    /// Lengths kept.
-    const KEPT: usize = 16;
-
-    fn new(tau: f64) -> LagFactors {
-        LagFactors {
-            tau,
-            seen: [(f64::NAN, 1.0); LagFactors::KEPT],
-            next: 0,
-        }
-    }
-
-    /// The factor of substep length `h`. [1]
-    #[inline]
-    fn at(&mut self, h: f64) -> f64 {
-        if let Some((_, f)) = self.seen.iter().find(|(seen, _)| *seen == h) {
-            return *f;
-        }
-        let f = if self.tau > 0.0 {
-            1.0 - (-h / self.tau).exp()
-        } else {
-            1.0
-        };
-        self.seen[self.next] = (h, f);
-        self.next = (self.next + 1) % LagFactors::KEPT;
-        f
-    }
 }
 
 /// A prepared model: the parameters with the pump's ripple tables built once.
