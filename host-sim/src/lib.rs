@@ -15,7 +15,8 @@
 //!   step log; [`can_commands`]: parameter changes as `cansend` lines and `candump` logs.
 //! - [`compensate`]: the torque feed-forward learned from bench logs; [`feedforward`]: what
 //!   it loads into a drive, and the table file that carries it.
-//! - [`memory`]: the allocator's freed blocks handed back between a command's stages.
+//! - [`memory`]: where the allocator takes large blocks from (mapped, or the heap while the
+//!   diagnosis fits), and the freed ones handed back between a command's stages.
 //! - [`diagnose`]: what the model gets wrong on a bench log, why, and the gain; [`fleet`]:
 //!   many logs diagnosed at once, one table, each drive's trends; [`timestamp`]: the RFC
 //!   3339 times of logs and predictions.

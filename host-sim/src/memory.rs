@@ -22,7 +22,7 @@ pub const FIT_MAPPED_FROM_B: usize = 1024 * 1024;
 /// diagnosis's whole-log columns come from the heap, whose freed space is kept and
 /// fragmented: the process then holds a fifth more than it uses. Does nothing where the
 /// allocator is not glibc's.
-pub fn map_blocks_from(bytes: usize) {
+fn map_blocks_from(bytes: usize) {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: mallopt only sets an allocator parameter (under the main arena's lock; a
     // refusal, return 0, leaves the threshold as it was); it touches no block.
@@ -69,7 +69,7 @@ impl Drop for FitStage {
 /// worker threads) and before its whole-log predictions, so that the process's peak is the
 /// larger of the two stages rather than their sum. Does nothing where the allocator is
 /// not glibc's.
-pub fn return_freed_memory() {
+fn return_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: malloc_trim only releases free pages of the allocator's own arenas; it
     // touches no block in use and is safe to call from any thread.

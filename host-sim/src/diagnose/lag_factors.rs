@@ -64,6 +64,13 @@ mod tests {
             assert_eq!(factors.at(h), expected, "{h:e}");
             assert_eq!(factors.at(h), expected, "{h:e} again");
         }
+        // Against the exponential's series: for h ≪ τ the factor is h/τ − (h/τ)²/2 + (h/τ)³/6
+        // to within (h/τ)⁴/24 (an alternating series), and 1 − e^(−x) loses a few units of
+        // 1's last place to the cancellation.
+        let mut fresh = LagFactors::new(1.0);
+        let x = 1e-3;
+        let series = x - x * x / 2.0 + x * x * x / 6.0;
+        assert!((fresh.at(x) - series).abs() < x.powi(4) / 24.0 + 4.0 * f64::EPSILON);
         let mut none = LagFactors::new(0.0);
         assert_eq!(none.at(0.5e-3), 1.0);
     }
