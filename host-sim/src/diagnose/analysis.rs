@@ -13,13 +13,14 @@
 //! 7. [`super::result`]: the scores, the evidence for the report (residual signatures and
 //!    order spectra of the baseline) and the contract's result.
 
-use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
+use super::angle_locked::{voltage_lines_of, EmfLines, LineReading, ShaftConstants};
 use super::calibration::{calibrate, test_release_at_nominal, Release};
 use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
 use super::contributions::contributions;
 use super::cylinder::{self};
 use super::diagnosis::Diagnosis;
 use super::displacement;
+use super::emf_law::dead_time_tested;
 use super::error::DiagnoseError;
 use super::facts::LogFacts;
 use super::findings::{trace_step, traced_all, Analysis};
@@ -266,9 +267,18 @@ pub fn analyse_reporting(
             },
         },
     );
-    // With the voltages logged the electrical relation reads the dead time directly.
-    if rel.electrical.is_some() {
+    // With the voltages logged the electrical relation reads the dead time directly, and
+    // the flux harmonics' voltage lines read as a dead time's.
+    if let (Some(_), Some(c)) = (&rel.electrical, &cal.electrical) {
         line_tests.retain(|t| t.effect != "dead_time");
+        let from_lines = line_tests.iter().find_map(|t| match &t.extension {
+            Extension::TorqueLine(f) => f.emf_law.and_then(|law| {
+                let val = voltage_lines_of(f, &line_val, rig, shaft, orders);
+                dead_time_tested(&law, f.windows, &val, &c.fitted.values)
+            }),
+            _ => None,
+        });
+        line_tests.extend(from_lines);
     }
     tested.extend(line_tests);
     progress.step("predictions");

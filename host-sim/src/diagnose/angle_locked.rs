@@ -18,7 +18,8 @@
 //! a voltage disturbance moving current and angle together cannot pass for a torque.
 
 use crate::diagnose::back_emf::{back_emf_lines, voltage_lines, LineObservation, Stator};
-use crate::diagnose::lines::{OrderLines, WindowLines};
+use crate::diagnose::emf_law::{emf_law, EmfLaw, EmfLine};
+use crate::diagnose::lines::{OrderLines, WindowLines, DEAD_TIME_BANDS_A};
 use plant_model::motor::Motor;
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
@@ -129,6 +130,9 @@ pub struct LineFit {
     pub coherent: bool,
     /// The flux harmonics' back-EMF lines fitted with the torque line.
     pub emf: EmfLines,
+    /// Flux harmonics with the voltages: their voltage lines read as a back-EMF and as a
+    /// dead time's ([`super::emf_law`]); `None` otherwise.
+    pub emf_law: Option<EmfLaw>,
 }
 
 /// One line an effect explains in one window, and whether it follows the flux harmonics'
@@ -137,6 +141,8 @@ pub struct LineFit {
 struct Observation {
     of: LineObservation,
     free_d: bool,
+    /// A back-EMF voltage line: the dead time's lines on its axis per fade band. [V]
+    dead_time: Option<[Complex64; DEAD_TIME_BANDS_A.len()]>,
 }
 
 /// The lines `effect` explains in window `w`: its torque line, and, for flux harmonics,
@@ -168,6 +174,7 @@ fn observations(
                 var,
             },
             free_d: false,
+            dead_time: None,
         });
     }
     if effect == LineEffect::FluxHarmonics {
@@ -177,13 +184,21 @@ fn observations(
             EmfLines::Voltages(s) => voltage_lines(w, o, rig, &s, candidates),
         };
         if let Some([q, d]) = lines {
+            // The dead time's voltage lines on each axis (d first), with the voltages.
+            let per_band = |axis: usize| {
+                let v = &o.dead_time_voltages;
+                (matches!(emf, EmfLines::Voltages(_)) && v.len() == DEAD_TIME_BANDS_A.len())
+                    .then(|| std::array::from_fn(|b| v[b][axis]))
+            };
             out.push(Observation {
                 of: q,
                 free_d: false,
+                dead_time: per_band(1),
             });
             out.push(Observation {
                 of: d,
                 free_d: true,
+                dead_time: per_band(0),
             });
         }
     }
@@ -277,6 +292,7 @@ pub fn fit_line(
             2 * obs.len(),
         )
     };
+    let emf_lines = emf_lines_of(&obs);
     Some(LineFit {
         effect,
         amplitude,
@@ -287,7 +303,38 @@ pub fn fit_line(
         windows: per_window.len(),
         coherent,
         emf,
+        emf_law: emf_law(&emf_lines),
     })
+}
+
+/// The back-EMF voltage lines among `obs`, with the dead time's regressors.
+fn emf_lines_of(obs: &[Observation]) -> Vec<EmfLine> {
+    obs.iter()
+        .filter_map(|o| {
+            o.dead_time.map(|dead_time| EmfLine {
+                of: o.of,
+                d_axis: o.free_d,
+                dead_time,
+            })
+        })
+        .collect()
+}
+
+/// The flux harmonics' back-EMF voltage lines of `fit` in the windows `lines` (the
+/// validation segment's), as [`super::emf_law`] reads them; empty unless `fit` is the flux
+/// harmonics' with the voltages.
+pub fn voltage_lines_of(
+    fit: &LineFit,
+    lines: &[&WindowLines],
+    rig: &Rig,
+    shaft: ShaftConstants,
+    candidates: &[u32],
+) -> Vec<EmfLine> {
+    let obs: Vec<Observation> = lines
+        .iter()
+        .flat_map(|w| observations(fit.effect, w, rig, shaft, candidates, fit.emf))
+        .collect();
+    emf_lines_of(&obs)
 }
 
 /// How much of the line power `fit` predicts in the windows `lines` (the validation
@@ -303,7 +350,7 @@ pub fn line_gain(
     let mut gain = 0.0;
     let mut n = 0;
     for w in lines {
-        for Observation { of: o, free_d } in
+        for Observation { of: o, free_d, .. } in
             observations(fit.effect, w, rig, shaft, candidates, fit.emf)
         {
             let predicted = if !fit.coherent {

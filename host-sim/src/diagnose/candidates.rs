@@ -418,9 +418,16 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         ),
     };
     let with_emf = f.emf.describe();
+    let law = f.emf_law.map_or(String::new(), |l| {
+        format!(
+            "; its voltage lines as a back-EMF Λ = {:.1}, as a dead time's Λ = {:.1} \
+             ({:.3e} s, fade band {:.2} A)",
+            l.emf_lambda, l.dead_time_lambda, l.dead_time_s, l.band_a
+        )
+    });
     let evidence = format!(
         "unexplained torque line at order {order}{with_emf} over {} steady window(s){}: {what}; \
-         Λ = {:.1} ({} degrees of freedom)",
+         Λ = {:.1} ({} degrees of freedom){law}",
         f.windows,
         if f.coherent {
             ", phase-locked to the logged angle"

@@ -64,26 +64,52 @@ pub fn why_not(t: &Tested) -> Option<String> {
 /// Applies the structural vetoes across `tested`: an inverter dead time and the flux
 /// harmonics share the lines at order 6·p_n, and only one of them is named.
 ///
-/// With the angle logged both are fitted to those lines: without voltages the dead time
-/// from the current lines and the flux harmonics with their back-EMF's current lines; with
-/// the voltages the dead time by the electrical relation and the flux harmonics with their
-/// back-EMF in the voltage lines ([`crate::diagnose::back_emf`]). The one standing further
-/// above its own significance threshold (Λ less the χ² quantile of its degrees of freedom:
-/// the flux harmonics' free d-axis amplitude costs them two more) explains them; the other
-/// is vetoed. Without the angle the flux harmonics have only the torque line's magnitudes,
-/// and a significant one vetoes the dead time (a dead time moves current and shaft
-/// together and leaves no torque).
+/// With the angle and the voltages logged both laws are fitted to the same voltage lines
+/// ([`crate::diagnose::emf_law`]): a back-EMF growing with the speed (four degrees of
+/// freedom) and the dead-time voltage the logged currents make (one); the one standing
+/// further above its χ² quantile explains them and the other is vetoed (every dead-time
+/// reading, the electrical relation's too). Without the voltages the dead time is fitted to
+/// the current lines and the flux harmonics with their back-EMF's current lines: the one
+/// whose Λ stands further above its own threshold is named. Without the angle the flux
+/// harmonics have only the torque line's magnitudes, and a significant one vetoes the dead
+/// time (a dead time moves current and shaft together and leaves no torque).
 pub fn apply_vetoes(tested: &mut [Tested]) {
     use crate::diagnose::angle_locked::EmfLines;
     use crate::diagnose::candidates::Extension;
     let flux = tested.iter().position(|t| t.effect == "flux_harmonics");
-    let dead = tested.iter().position(|t| t.effect == "dead_time");
-    let (Some(f), Some(d)) = (flux, dead) else {
+    let dead: Vec<usize> = (0..tested.len())
+        .filter(|&i| tested[i].effect == "dead_time")
+        .collect();
+    let (Some(f), Some(&d)) = (flux, dead.first()) else {
         return;
     };
+    let line = match &tested[f].extension {
+        Extension::TorqueLine(l) => Some(l),
+        _ => None,
+    };
+    if let Some(law) = line.and_then(|l| l.emf_law) {
+        let (me, md) = (
+            law.emf_lambda - threshold(4),
+            law.dead_time_lambda - threshold(1),
+        );
+        if md > 0.0 && md > me {
+            tested[f].veto = Some(format!(
+                "its voltage lines at 6·p_n are an inverter dead time's, read from the logged \
+                 currents (Λ − threshold {md:.1} against {me:.1} as a back-EMF)"
+            ));
+        } else if me > 0.0 {
+            for i in dead {
+                tested[i].veto = Some(format!(
+                    "the voltage lines at 6·p_n are a back-EMF's (Λ − threshold {me:.1} \
+                     against {md:.1} as a dead time's)"
+                ));
+            }
+        }
+        return;
+    }
     let margin = |t: &Tested| t.lambda - threshold(t.dof);
     let (mf, md) = (margin(&tested[f]), margin(&tested[d]));
-    let joint = matches!(&tested[f].extension, Extension::TorqueLine(l) if l.emf != EmfLines::None);
+    let joint = line.is_some_and(|l| l.emf != EmfLines::None);
     if joint && mf > 0.0 && mf >= md {
         tested[d].veto = Some(format!(
             "the flux harmonics explain the lines at 6·p_n better (Λ − threshold {mf:.1} \

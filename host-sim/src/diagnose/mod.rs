@@ -15,7 +15,8 @@
 //!   shared by the stages.
 //! - [`lines`], [`angle_locked`], [`dead_time`]: the angle-locked lines of the steady
 //!   windows and the effects that make them; [`loop_response`]: the Table 1 loops'
-//!   responses the line readings use.
+//!   responses the line readings use; [`emf_law`]: the 6·p_n voltage lines read as a
+//!   back-EMF and as a dead time's voltage.
 //! - [`candidates`], [`decision`]: every effect tested, and the one the log convicts.
 //! - [`displacement`]: the pump's displacement fixed by the torque balance and the stator
 //!   voltages, at which a blocked cylinder's leakage and bulk modulus are read.
@@ -40,6 +41,7 @@ pub mod decision;
 pub mod diagnosis;
 pub mod displacement;
 pub mod electrical;
+pub mod emf_law;
 mod error;
 pub mod facts;
 pub mod findings;
