@@ -142,6 +142,94 @@ pub fn decide(tested: &[Tested]) -> Option<usize> {
 mod tests {
     use super::*;
 
+    use crate::diagnose::angle_locked::{EmfLines, LineEffect, LineFit};
+    use crate::diagnose::back_emf::Stator;
+    use crate::diagnose::calibration::Release;
+    use crate::diagnose::candidates::Extension;
+    use crate::diagnose::emf_law::{dead_time_tested, EmfLaw};
+    use rustfft::num_complex::Complex64;
+
+    /// The flux harmonics' test with the voltages logged, its voltage lines read by both
+    /// laws as `law` says, and the dead time's two readings (the electrical relation's, Λ
+    /// 32, and the voltage lines').
+    fn tested(law: EmfLaw) -> Vec<Tested> {
+        let fit = LineFit {
+            effect: LineEffect::FluxHarmonics,
+            amplitude: Complex64::new(0.04, 0.0),
+            information: 1e6,
+            back_emf_d: Complex64::default(),
+            lambda: 2462.0,
+            dof: 4,
+            windows: 2,
+            coherent: true,
+            emf: EmfLines::Voltages(Stator {
+                r_s_ohm: 1.15,
+                l_d_h: 5.5e-3,
+                l_q_h: 13.2e-3,
+                psi_f_wb: 0.188,
+            }),
+            emf_law: Some(law),
+        };
+        let plain = |effect, lambda, dof, extension| Tested {
+            effect,
+            parameters: Vec::new(),
+            lambda,
+            dof,
+            outside_band: true,
+            validation_gain: None,
+            veto: None,
+            evidence: String::new(),
+            extension,
+            standard_errors: Vec::new(),
+            release: Release::Nothing,
+            fit: None,
+            ambiguous_with: Vec::new(),
+        };
+        vec![
+            plain("dead_time", 32.0, 1, Extension::Electrical(vec![0.0; 5])),
+            plain("flux_harmonics", 2462.0, 4, Extension::TorqueLine(fit)),
+            dead_time_tested(&law, 2, &[], &[1.15, 5.5e-3, 13.2e-3, 0.188, 0.0]).unwrap(),
+        ]
+    }
+
+    #[test]
+    fn the_law_that_explains_the_voltage_lines_better_names_them() {
+        // A dead time's lines: 4599 as its own law (1 dof) against 2543 as a back-EMF's
+        // (4 dof). The flux harmonics are vetoed whatever their Λ on the torque line, and
+        // both dead-time readings stand (the stronger is named).
+        let law = EmfLaw {
+            emf_lambda: 2542.7,
+            dead_time_lambda: 4598.6,
+            dead_time_s: 1.06e-6,
+            band_a: 0.2,
+        };
+        let mut t = tested(law);
+        apply_vetoes(&mut t);
+        assert!(t[1].veto.is_some() && t[0].veto.is_none() && t[2].veto.is_none());
+        assert_eq!(decide(&t), Some(2));
+        // A back-EMF's lines: every dead-time reading is vetoed.
+        let law = EmfLaw {
+            emf_lambda: 632.0,
+            dead_time_lambda: 25.2,
+            dead_time_s: 5.0e-7,
+            band_a: 0.8,
+        };
+        let mut t = tested(law);
+        apply_vetoes(&mut t);
+        assert!(t[1].veto.is_none() && t[0].veto.is_some() && t[2].veto.is_some());
+        assert_eq!(decide(&t), Some(1));
+        // Within the margin the extra three degrees of freedom cost: 4 dof need 8.4 more.
+        let law = EmfLaw {
+            emf_lambda: 100.0 + threshold(4) - threshold(1) - 1.0,
+            dead_time_lambda: 100.0,
+            dead_time_s: 1e-6,
+            band_a: 0.2,
+        };
+        let mut t = tested(law);
+        apply_vetoes(&mut t);
+        assert!(t[1].veto.is_some(), "{:?}", t[1].veto);
+    }
+
     #[test]
     fn thresholds_are_the_chi_square_quantiles() {
         // χ²(1) at 1 − 1e-4 is 15.137; χ²(2) is −2·ln(1e-4) = 18.42 exactly.
