@@ -93,7 +93,7 @@ pub(super) fn mark(
     bulk_modulus_pa: f64,
 ) {
     for &(a, b, separates) in PAIRS {
-        let (Some(i), Some(j)) = (position(tested, a), position(tested, b)) else {
+        let (Some(i), Some(j)) = (position(tested, first, a), position(tested, first, b)) else {
             continue;
         };
         if !(named.contains(&i) || named.contains(&j)) || named.contains(&i) && named.contains(&j) {
@@ -167,8 +167,13 @@ fn only_through_named(t: &Tested) -> bool {
     t.outside_band && (why_not(t).is_none() || t.veto.is_some())
 }
 
-fn position(tested: &[Tested], effect: &str) -> Option<usize> {
-    tested.iter().position(|t| t.effect == effect)
+/// The test of `effect` with the largest first-round Λ (`first`): an effect read two ways
+/// (a dead time by the electrical relation and from the voltage lines) is judged by the
+/// stronger reading.
+fn position(tested: &[Tested], first: &[f64], effect: &str) -> Option<usize> {
+    (0..tested.len())
+        .filter(|&k| tested[k].effect == effect)
+        .max_by(|&x, &y| first[x].total_cmp(&first[y]))
 }
 
 /// The one speed the steady windows turn at (their row-weighted mean magnitude), when
@@ -204,5 +209,25 @@ mod tests {
         assert!(!alike(1000.0, 850.0));
         // A test below its threshold is not an alternative.
         assert!(!alike(20.0, -1.0));
+    }
+
+    #[test]
+    fn an_effect_read_two_ways_is_judged_by_its_stronger_reading() {
+        use crate::diagnose::candidates::Extension;
+        let dead = || Tested::bare("dead_time", 0.0, 1, Extension::Electrical(Vec::new()));
+        let flux = Tested::bare("flux_harmonics", 0.0, 4, Extension::Electrical(Vec::new()));
+        let tested = [dead(), flux, dead()];
+        assert_eq!(
+            position(&tested, &[32.0, 2462.0, 4599.0], "dead_time"),
+            Some(2)
+        );
+        assert_eq!(
+            position(&tested, &[32.0, 2462.0, 3.0], "dead_time"),
+            Some(0)
+        );
+        assert_eq!(
+            position(&tested, &[32.0, 2462.0, 3.0], "cogging_torque"),
+            None
+        );
     }
 }

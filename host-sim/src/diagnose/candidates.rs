@@ -102,6 +102,29 @@ pub struct Tested {
     pub ambiguous_with: Vec<&'static str>,
 }
 
+#[cfg(test)]
+impl Tested {
+    /// A test of `effect` with Λ `lambda` on `dof` degrees of freedom, outside its band and
+    /// otherwise blank: for the decision's unit tests.
+    pub fn bare(effect: &'static str, lambda: f64, dof: usize, extension: Extension) -> Tested {
+        Tested {
+            effect,
+            parameters: Vec::new(),
+            lambda,
+            dof,
+            outside_band: true,
+            validation_gain: None,
+            veto: None,
+            evidence: String::new(),
+            extension,
+            standard_errors: Vec::new(),
+            release: Release::Nothing,
+            fit: None,
+            ambiguous_with: Vec::new(),
+        }
+    }
+}
+
 /// The catalogue's effect a release tests, the indices of the parameters it may release
 /// (the first the main one) and the extension at the released values `v`.
 fn released_effect(release: Release, v: &[f64]) -> (&'static [usize], &'static str, Extension) {

@@ -144,7 +144,6 @@ mod tests {
 
     use crate::diagnose::angle_locked::{EmfLines, LineEffect, LineFit};
     use crate::diagnose::back_emf::Stator;
-    use crate::diagnose::calibration::Release;
     use crate::diagnose::candidates::Extension;
     use crate::diagnose::emf_law::{dead_time_tested, EmfLaw};
     use rustfft::num_complex::Complex64;
@@ -170,24 +169,9 @@ mod tests {
             }),
             emf_law: Some(law),
         };
-        let plain = |effect, lambda, dof, extension| Tested {
-            effect,
-            parameters: Vec::new(),
-            lambda,
-            dof,
-            outside_band: true,
-            validation_gain: None,
-            veto: None,
-            evidence: String::new(),
-            extension,
-            standard_errors: Vec::new(),
-            release: Release::Nothing,
-            fit: None,
-            ambiguous_with: Vec::new(),
-        };
         vec![
-            plain("dead_time", 32.0, 1, Extension::Electrical(vec![0.0; 5])),
-            plain("flux_harmonics", 2462.0, 4, Extension::TorqueLine(fit)),
+            Tested::bare("dead_time", 32.0, 1, Extension::Electrical(vec![0.0; 5])),
+            Tested::bare("flux_harmonics", 2462.0, 4, Extension::TorqueLine(fit)),
             dead_time_tested(&law, 2, &[], &[1.15, 5.5e-3, 13.2e-3, 0.188, 0.0]).unwrap(),
         ]
     }
