@@ -317,7 +317,9 @@ fn release_evidence(
     )
 }
 
-fn short(v: f64) -> String {
+/// `v` with four decimals, or in scientific notation where that would lose it (below 10⁻²
+/// or from 10⁴ on: dead times in seconds, leakages in m³/(s·Pa), pressures in pascals).
+pub(crate) fn short(v: f64) -> String {
     if v != 0.0 && (v.abs() < 1e-2 || v.abs() >= 1e4) {
         format!("{v:.3e}")
     } else {

@@ -175,7 +175,7 @@ fn ranking_section(md: &mut String, d: &Diagnosis) {
         let params: Vec<String> = c
             .parameters
             .iter()
-            .map(|(n, v)| format!("{n} = {v:.4}"))
+            .map(|(n, v)| format!("{n} = {}", super::candidates::short(*v)))
             .collect();
         let _ = writeln!(
             md,
@@ -322,4 +322,21 @@ fn spectrum_figure(
         markers,
         true,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::candidates::short;
+
+    #[test]
+    fn small_and_large_parameters_keep_their_digits_in_the_ranking() {
+        // A dead time of about a microsecond and a leakage of 1e-13 m³/(s·Pa) were printed
+        // as 0.0000 with four decimals.
+        assert_eq!(short(1.063e-6), "1.063e-6");
+        assert_eq!(short(9.886e-13), "9.886e-13");
+        assert_eq!(short(4.599e6), "4.599e6");
+        assert_eq!(short(0.0397), "0.0397");
+        assert_eq!(short(-3.0364), "-3.0364");
+        assert_eq!(short(0.0), "0.0000");
+    }
 }
