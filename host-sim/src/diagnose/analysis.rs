@@ -15,12 +15,14 @@
 
 use super::angle_locked::{voltage_lines_of, EmfLines, LineReading, ShaftConstants};
 use super::calibration::{calibrate, test_release_at_nominal, Release};
-use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
+use super::candidates::{
+    dead_time_tested, from_release, test_lines, test_relation, Extension, Tested,
+};
 use super::contributions::contributions;
 use super::cylinder::{self};
 use super::diagnosis::Diagnosis;
 use super::displacement;
-use super::emf_law::dead_time_tested;
+
 use super::error::DiagnoseError;
 use super::facts::LogFacts;
 use super::findings::{trace_step, traced_all, Analysis};

@@ -9,7 +9,7 @@
 //! | `pressure_sensor_lag` | hydraulic relation, lag released | 0–2.5 ms |
 //! | `shaft_friction` | mechanical relation, Coulomb torque released | 0–0.02 N·m |
 //! | `cylinder_friction` | cylinder relation, Coulomb and breakaway force released together (the breakaway where the piston rests), read at the rig file's transducer zero unless a reversal tells the zero apart | each 0–3× the rig's, with the transducer zero ±30 kPa |
-//! | `dead_time` | electrical relation (voltages logged), else the d/q current lines at 6·p_n | 0–0.1 µs |
+//! | `dead_time` | electrical relation and the 6·p_n voltage lines (voltages logged), else the d/q current lines at 6·p_n | 0–0.1 µs |
 //! | `cogging_torque` | torque line at the slot order | 0.01 N·m |
 //! | `flux_harmonics` | torque line at 6·p_n ∝ mean torque, and (angle logged) its back-EMF's current lines | 0.5 % |
 //! | `piston_ripple` | torque line at 2z ∝ Δp | the kinematic ripple |
@@ -31,7 +31,8 @@ use crate::diagnose::cylinder;
 use crate::diagnose::dead_time::{
     dead_time_gain, fit_dead_time, DeadTimeFit, REFERENCE_DEAD_TIME_S,
 };
-use crate::diagnose::electrical::DEAD_TIME_BAND_S;
+use crate::diagnose::electrical::{ix as elec, DEAD_TIME_BAND_S};
+use crate::diagnose::emf_law::{EmfLaw, EmfLine};
 use crate::diagnose::hydraulic::nominal_leakage;
 use crate::diagnose::hydraulic_relation::hyd;
 use crate::diagnose::least_squares::ParamSpec;
@@ -482,6 +483,44 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         fit: None,
         ambiguous_with: Vec::new(),
     }
+}
+
+/// The dead time the flux harmonics' voltage lines read as, tested like any effect: its
+/// Λ on the identification windows, its gain on the validation windows' lines
+/// (`validation`), and the electrical relation's calibrated `values` with that dead time
+/// as the extended model. `None` when the lines read as no dead time.
+pub fn dead_time_tested(
+    law: &EmfLaw,
+    windows: usize,
+    validation: &[EmfLine],
+    values: &[f64],
+) -> Option<Tested> {
+    if law.dead_time_s <= 0.0 {
+        return None;
+    }
+    let se = law.dead_time_s / law.dead_time_lambda.max(f64::MIN_POSITIVE).sqrt();
+    let mut extended = values.to_vec();
+    *extended.get_mut(elec::DEAD_TIME)? = law.dead_time_s;
+    Some(Tested {
+        effect: "dead_time",
+        parameters: vec![("dead_time_s", law.dead_time_s)],
+        lambda: law.dead_time_lambda,
+        dof: 1,
+        outside_band: law.dead_time_s - 2.0 * se > DEAD_TIME_BAND_S,
+        validation_gain: law.gain(validation),
+        veto: None,
+        evidence: format!(
+            "d and q voltage lines at order 6·p_n over {windows} steady window(s) as an \
+             inverter's dead-time voltage read from the logged currents (fade band {:.2} A): \
+             Λ = {:.1}, against Λ = {:.1} for a back-EMF's lines",
+            law.band_a, law.dead_time_lambda, law.emf_lambda
+        ),
+        extension: Extension::Electrical(extended),
+        standard_errors: vec![("dead_time_s", se)],
+        release: Release::Nothing,
+        fit: None,
+        ambiguous_with: Vec::new(),
+    })
 }
 
 fn dead_time_verdict(f: DeadTimeFit, validation_gain: Option<f64>, windows: usize) -> Tested {

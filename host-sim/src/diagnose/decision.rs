@@ -144,8 +144,9 @@ mod tests {
 
     use crate::diagnose::angle_locked::{EmfLines, LineEffect, LineFit};
     use crate::diagnose::back_emf::Stator;
+    use crate::diagnose::candidates::dead_time_tested;
     use crate::diagnose::candidates::Extension;
-    use crate::diagnose::emf_law::{dead_time_tested, EmfLaw};
+    use crate::diagnose::emf_law::EmfLaw;
     use rustfft::num_complex::Complex64;
 
     /// The flux harmonics' test with the voltages logged, its voltage lines read by both

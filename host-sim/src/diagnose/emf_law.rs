@@ -23,9 +23,6 @@
 //! of freedom) in [`super::decision::apply_vetoes`].
 
 use crate::diagnose::back_emf::LineObservation;
-use crate::diagnose::calibration::Release;
-use crate::diagnose::candidates::{Extension, Tested};
-use crate::diagnose::electrical::{ix, DEAD_TIME_BAND_S};
 use crate::diagnose::lines::{DEAD_TIME_BANDS_A, REFERENCE_DEAD_TIME_S};
 use rustfft::num_complex::Complex64;
 
@@ -137,44 +134,6 @@ impl EmfLaw {
             .sum();
         (n > 0).then_some(gain)
     }
-}
-
-/// The dead time the flux harmonics' voltage lines read as, tested like any effect: its
-/// Λ on the identification windows, its gain on the validation windows' lines
-/// (`validation`), and the electrical relation's calibrated `values` with that dead time
-/// as the extended model. `None` when the lines read as no dead time.
-pub fn dead_time_tested(
-    law: &EmfLaw,
-    windows: usize,
-    validation: &[EmfLine],
-    values: &[f64],
-) -> Option<Tested> {
-    if law.dead_time_s <= 0.0 {
-        return None;
-    }
-    let se = law.dead_time_s / law.dead_time_lambda.max(f64::MIN_POSITIVE).sqrt();
-    let mut extended = values.to_vec();
-    *extended.get_mut(ix::DEAD_TIME)? = law.dead_time_s;
-    Some(Tested {
-        effect: "dead_time",
-        parameters: vec![("dead_time_s", law.dead_time_s)],
-        lambda: law.dead_time_lambda,
-        dof: 1,
-        outside_band: law.dead_time_s - 2.0 * se > DEAD_TIME_BAND_S,
-        validation_gain: law.gain(validation),
-        veto: None,
-        evidence: format!(
-            "d and q voltage lines at order 6·p_n over {windows} steady window(s) as an \
-             inverter's dead-time voltage read from the logged currents (fade band {:.2} A): \
-             Λ = {:.1}, against Λ = {:.1} for a back-EMF's lines",
-            law.band_a, law.dead_time_lambda, law.emf_lambda
-        ),
-        extension: Extension::Electrical(extended),
-        standard_errors: vec![("dead_time_s", se)],
-        release: Release::Nothing,
-        fit: None,
-        ambiguous_with: Vec::new(),
-    })
 }
 
 #[cfg(test)]
