@@ -22,7 +22,6 @@ use super::contributions::contributions;
 use super::cylinder::{self};
 use super::diagnosis::Diagnosis;
 use super::displacement;
-
 use super::error::DiagnoseError;
 use super::facts::LogFacts;
 use super::findings::{trace_step, traced_all, Analysis};

@@ -141,11 +141,9 @@ pub fn decide(tested: &[Tested]) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
     use crate::diagnose::angle_locked::{EmfLines, LineEffect, LineFit};
     use crate::diagnose::back_emf::Stator;
-    use crate::diagnose::candidates::dead_time_tested;
-    use crate::diagnose::candidates::Extension;
+    use crate::diagnose::candidates::{dead_time_tested, Extension};
     use crate::diagnose::emf_law::EmfLaw;
     use rustfft::num_complex::Complex64;
 
