@@ -13,11 +13,9 @@
 //! 7. [`super::result`]: the scores, the evidence for the report (residual signatures and
 //!    order spectra of the baseline) and the contract's result.
 
-use super::angle_locked::{voltage_lines_of, EmfLines, LineReading, ShaftConstants};
+use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
 use super::calibration::{calibrate, test_release_at_nominal, Release};
-use super::candidates::{
-    dead_time_tested, from_release, test_lines, test_relation, Extension, Tested,
-};
+use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
 use super::contributions::contributions;
 use super::cylinder::{self};
 use super::diagnosis::Diagnosis;
@@ -253,13 +251,12 @@ pub fn analyse_reporting(
     progress.step("testing effects");
     // 4. Every effect tested.
     let mut tested = test_relations(&rel, &cal, &facts, rig, progress);
-    let mut line_tests = test_lines(
+    let line_tests = test_lines(
         &line_id,
         &line_val,
         rig,
         shaft,
         orders,
-        &[rig.motor.cogging_fundamental_order()],
         LineReading {
             coherent: facts.angle_logged,
             emf: match &cal.electrical {
@@ -267,20 +264,8 @@ pub fn analyse_reporting(
                 None => EmfLines::Currents,
             },
         },
+        cal.electrical.as_ref().map(|c| c.fitted.values.as_slice()),
     );
-    // With the voltages logged the electrical relation reads the dead time directly, and
-    // the flux harmonics' voltage lines read as a dead time's.
-    if let (Some(_), Some(c)) = (&rel.electrical, &cal.electrical) {
-        line_tests.retain(|t| t.effect != "dead_time");
-        let from_lines = line_tests.iter().find_map(|t| match &t.extension {
-            Extension::TorqueLine(f) => f.emf_law.and_then(|law| {
-                let val = voltage_lines_of(f, &line_val, rig, shaft, orders);
-                dead_time_tested(&law, f.windows, &val, &c.fitted.values)
-            }),
-            _ => None,
-        });
-        line_tests.extend(from_lines);
-    }
     tested.extend(line_tests);
     progress.step("predictions");
     // 5. Selection: every effect the log convicts.

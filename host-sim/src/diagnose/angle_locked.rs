@@ -17,7 +17,9 @@
 //! K_t and J could leave of the measured current and angle lines ([`TORQUE_TOLERANCE`]):
 //! a voltage disturbance moving current and angle together cannot pass for a torque.
 
-use crate::diagnose::back_emf::{back_emf_lines, voltage_lines, LineObservation, Stator};
+use crate::diagnose::back_emf::{
+    back_emf_lines, voltage_lines, weighted_amplitude, LineObservation, Stator,
+};
 use crate::diagnose::emf_law::{emf_law, EmfLaw, EmfLine};
 use crate::diagnose::lines::{OrderLines, WindowLines, DEAD_TIME_BANDS_A};
 use plant_model::motor::Motor;
@@ -208,15 +210,7 @@ fn observations(
 /// The weighted least-squares amplitude of `obs` (those with `free_d` as given) and its
 /// information; `None` without information.
 fn amplitude_of(obs: &[Observation], free_d: bool) -> Option<(Complex64, f64)> {
-    let group = obs.iter().filter(|o| o.free_d == free_d).map(|o| &o.of);
-    let info: f64 = group.clone().map(|o| o.regressor.norm_sqr() / o.var).sum();
-    (info > 0.0).then(|| {
-        let a = group
-            .map(|o| o.regressor.conj() * o.line / o.var)
-            .sum::<Complex64>()
-            / info;
-        (a, info)
-    })
+    weighted_amplitude(obs.iter().filter(|o| o.free_d == free_d).map(|o| &o.of))
 }
 
 /// Which lines carry the flux harmonics' back-EMF beside their torque line
@@ -303,7 +297,7 @@ pub fn fit_line(
         windows: per_window.len(),
         coherent,
         emf,
-        emf_law: emf_law(&emf_lines),
+        emf_law: emf_law(&emf_lines, crate::diagnose::dead_time::max_scale(rig)),
     })
 }
 
@@ -320,39 +314,31 @@ fn emf_lines_of(obs: &[Observation]) -> Vec<EmfLine> {
         .collect()
 }
 
-/// The flux harmonics' back-EMF voltage lines of `fit` in the windows `lines` (the
-/// validation segment's), as [`super::emf_law`] reads them; empty unless `fit` is the flux
-/// harmonics' with the voltages.
-pub fn voltage_lines_of(
-    fit: &LineFit,
-    lines: &[&WindowLines],
-    rig: &Rig,
-    shaft: ShaftConstants,
-    candidates: &[u32],
-) -> Vec<EmfLine> {
-    let obs: Vec<Observation> = lines
-        .iter()
-        .flat_map(|w| observations(fit.effect, w, rig, shaft, candidates, fit.emf))
-        .collect();
-    emf_lines_of(&obs)
+/// What `fit` predicts in the windows `lines` (the validation segment's).
+pub struct LineValidation {
+    /// The line power it predicts: Σ (|y|² − |y − ŷ|²)/σ² over its lines, positive when the
+    /// fitted line is there; `None` without a line. [1]
+    pub gain: Option<f64>,
+    /// The flux harmonics' back-EMF voltage lines there, as [`super::emf_law`] reads them
+    /// (empty unless `fit` is the flux harmonics' with the voltages).
+    pub voltage_lines: Vec<EmfLine>,
 }
 
-/// How much of the line power `fit` predicts in the windows `lines` (the validation
-/// segment's): Σ (|y|² − |y − ŷ|²)/σ² over its lines, positive when the fitted line is
-/// there. [1]
+/// `fit` on the windows `lines` (the validation segment's), read as it was fitted.
 pub fn line_gain(
     fit: &LineFit,
     lines: &[&WindowLines],
     rig: &Rig,
     shaft: ShaftConstants,
     candidates: &[u32],
-) -> Option<f64> {
-    let mut gain = 0.0;
-    let mut n = 0;
-    for w in lines {
-        for Observation { of: o, free_d, .. } in
-            observations(fit.effect, w, rig, shaft, candidates, fit.emf)
-        {
+) -> LineValidation {
+    let obs: Vec<Observation> = lines
+        .iter()
+        .flat_map(|w| observations(fit.effect, w, rig, shaft, candidates, fit.emf))
+        .collect();
+    let gain = obs
+        .iter()
+        .map(|&Observation { of: o, free_d, .. }| {
             let predicted = if !fit.coherent {
                 // Only the magnitude is known: the best phase, i.e. the magnitudes compared.
                 o.line
@@ -362,11 +348,13 @@ pub fn line_gain(
             } else {
                 fit.amplitude * o.regressor
             };
-            gain += (o.line.norm_sqr() - (o.line - predicted).norm_sqr()) / o.var;
-            n += 1;
-        }
+            (o.line.norm_sqr() - (o.line - predicted).norm_sqr()) / o.var
+        })
+        .sum();
+    LineValidation {
+        gain: (!obs.is_empty()).then_some(gain),
+        voltage_lines: emf_lines_of(&obs),
     }
-    (n > 0).then_some(gain)
 }
 
 /// The current-sensor offset hypotheses: the controller's Clarke transform and the channel

@@ -65,6 +65,22 @@ pub struct LineObservation {
     pub var: f64,
 }
 
+/// The weighted least-squares complex amplitude of `lines` (each line its regressor times
+/// the amplitude, plus noise of its variance) and its information Σ |x|²/σ²; its likelihood
+/// ratio against no amplitude is |a|²·information. `None` without information.
+pub fn weighted_amplitude<'a>(
+    lines: impl Iterator<Item = &'a LineObservation> + Clone,
+) -> Option<(Complex64, f64)> {
+    let info: f64 = lines.clone().map(|o| o.regressor.norm_sqr() / o.var).sum();
+    (info > 0.0).then(|| {
+        let a = lines
+            .map(|o| o.regressor.conj() * o.line / o.var)
+            .sum::<Complex64>()
+            / info;
+        (a, info)
+    })
+}
+
 /// Relative uncertainty of the calibrated resistance, inductances and flux linkage in the
 /// voltage lines: R, L and ψ_f in that order (winding temperature, saturation, magnets). [1]
 pub const STATOR_TOLERANCE: [f64; 3] = [0.2, 0.1, 0.05];

@@ -28,9 +28,7 @@ use crate::diagnose::calibration::{
     test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
 };
 use crate::diagnose::cylinder;
-use crate::diagnose::dead_time::{
-    dead_time_gain, fit_dead_time, DeadTimeFit, REFERENCE_DEAD_TIME_S,
-};
+use crate::diagnose::dead_time::{dead_time_gain, fit_dead_time, standard_error, DeadTimeFit};
 use crate::diagnose::electrical::{ix as elec, DEAD_TIME_BAND_S};
 use crate::diagnose::emf_law::{EmfLaw, EmfLine};
 use crate::diagnose::hydraulic::nominal_leakage;
@@ -353,30 +351,43 @@ pub fn test_relation<R: Relation>(
         .collect()
 }
 
-/// The line effects' tests on the steady windows split at the validation segment.
+/// The line effects' tests on the steady windows split at the validation segment. With the
+/// voltages logged (`electrical`: the electrical relation's calibrated values) the dead
+/// time is read from the flux harmonics' voltage lines ([`dead_time_tested`]), beside the
+/// relation's own test, instead of from the current lines.
 pub fn test_lines(
     identification: &[&WindowLines],
     validation: &[&WindowLines],
     rig: &Rig,
     shaft: ShaftConstants,
     orders: &[u32],
-    cogging_orders: &[u32],
     reading: LineReading,
+    electrical: Option<&[f64]>,
 ) -> Vec<Tested> {
     let mut effects = vec![LineEffect::CurrentOffset, LineEffect::FluxHarmonics];
-    effects.extend(cogging_orders.iter().map(|k| LineEffect::Cogging(*k)));
+    effects.push(LineEffect::Cogging(rig.motor.cogging_fundamental_order()));
     effects.extend(RIPPLE_PISTONS.iter().map(|z| LineEffect::PistonRipple(*z)));
-    let mut out: Vec<Tested> = effects
-        .into_iter()
-        .filter_map(|e| {
-            let f = fit_line(e, identification, rig, shaft, orders, reading)?;
-            let gain = line_gain(&f, validation, rig, shaft, orders);
-            Some(line_verdict(f, gain, rig, shaft.kt))
-        })
-        .collect();
-    if let Some(f) = fit_dead_time(identification, rig, orders) {
-        let gain = dead_time_gain(&f, validation, rig, orders);
-        out.push(dead_time_verdict(f, gain, identification.len()));
+    let mut out = Vec::new();
+    for e in effects {
+        let Some(f) = fit_line(e, identification, rig, shaft, orders, reading) else {
+            continue;
+        };
+        let val = line_gain(&f, validation, rig, shaft, orders);
+        if let (Some(law), Some(values)) = (f.emf_law, electrical) {
+            out.extend(dead_time_tested(
+                &law,
+                f.windows,
+                &val.voltage_lines,
+                values,
+            ));
+        }
+        out.push(line_verdict(f, val.gain, rig, shaft.kt));
+    }
+    if electrical.is_none() {
+        if let Some(f) = fit_dead_time(identification, rig, orders) {
+            let gain = dead_time_gain(&f, validation, rig, orders);
+            out.push(dead_time_verdict(f, gain, identification.len()));
+        }
     }
     out
 }
@@ -448,7 +459,10 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         format!(
             "; its voltage lines as a back-EMF Λ = {:.1}, as a dead time's Λ = {:.1} \
              ({:.3e} s, fade band {:.2} A)",
-            l.emf_lambda, l.dead_time_lambda, l.dead_time_s, l.band_a
+            l.emf_lambda,
+            l.dead_time_lambda,
+            l.dead_time_s,
+            l.band_a()
         )
     });
     let evidence = format!(
@@ -498,7 +512,7 @@ pub fn dead_time_tested(
     if law.dead_time_s <= 0.0 {
         return None;
     }
-    let se = law.dead_time_s / law.dead_time_lambda.max(f64::MIN_POSITIVE).sqrt();
+    let se = standard_error(law.dead_time_s, law.dead_time_lambda);
     let mut extended = values.to_vec();
     *extended.get_mut(elec::DEAD_TIME)? = law.dead_time_s;
     Some(Tested {
@@ -513,7 +527,9 @@ pub fn dead_time_tested(
             "d and q voltage lines at order 6·p_n over {windows} steady window(s) as an \
              inverter's dead-time voltage read from the logged currents (fade band {:.2} A): \
              Λ = {:.1}, against Λ = {:.1} for a back-EMF's lines",
-            law.band_a, law.dead_time_lambda, law.emf_lambda
+            law.band_a(),
+            law.dead_time_lambda,
+            law.emf_lambda
         ),
         extension: Extension::Electrical(extended),
         standard_errors: vec![("dead_time_s", se)],
@@ -529,8 +545,7 @@ fn dead_time_verdict(f: DeadTimeFit, validation_gain: Option<f64>, windows: usiz
          loops pass an inverter's dead-time voltage (fade band {:.2} A): Λ = {:.1}",
         f.band_a, f.lambda
     );
-    let se_scale = REFERENCE_DEAD_TIME_S * (f.dead_time_s / REFERENCE_DEAD_TIME_S)
-        / f.lambda.max(f64::MIN_POSITIVE).sqrt();
+    let se_scale = standard_error(f.dead_time_s, f.lambda);
     Tested {
         effect: "dead_time",
         parameters: vec![("dead_time_s", f.dead_time_s)],

@@ -42,6 +42,18 @@ pub use crate::diagnose::lines::{DEAD_TIME_BANDS_A as BANDS_A, REFERENCE_DEAD_TI
 /// line divided by a vanishing model line would otherwise read as seconds). [1]
 pub const MAX_DEAD_TIME_PERIODS: f64 = 0.1;
 
+/// The largest dead time a line is read as on `rig` ([`MAX_DEAD_TIME_PERIODS`] of its PWM
+/// period), in units of [`REFERENCE_DEAD_TIME_S`]. [1]
+pub fn max_scale(rig: &Rig) -> f64 {
+    MAX_DEAD_TIME_PERIODS / rig.inverter.pwm_frequency_hz.max(1.0) / REFERENCE_DEAD_TIME_S
+}
+
+/// Standard error of a dead time `dead_time_s` read from lines with likelihood ratio
+/// `lambda` (Λ is the squared scale over its variance). [s]
+pub fn standard_error(dead_time_s: f64, lambda: f64) -> f64 {
+    dead_time_s / lambda.max(f64::MIN_POSITIVE).sqrt()
+}
+
 /// The dead time's sixth-harmonic d-q voltage at a constant current (i_d, i_q) for `band`,
 /// per [`REFERENCE_DEAD_TIME_S`]: the plant's inverter over one electrical turn. The
 /// reading without the angle, where the phases' zero crossings are not placed. [V]
@@ -165,8 +177,7 @@ fn loop_lines(w: &WindowLines, o: &OrderLines, rig: &Rig) -> Option<[Complex64; 
 /// Fits the dead time to the d and q current lines at order 6·p_n of `lines`.
 pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> Option<DeadTimeFit> {
     let mut best: Option<(f64, DeadTimeFit)> = None;
-    let max_scale =
-        MAX_DEAD_TIME_PERIODS / rig.inverter.pwm_frequency_hz.max(1.0) / REFERENCE_DEAD_TIME_S;
+    let max_scale = max_scale(rig);
     let coherent = lines
         .iter()
         .any(|w| w.orders.iter().any(|o| !o.dead_time_voltages.is_empty()));

@@ -175,40 +175,32 @@ mod tests {
         ]
     }
 
+    /// The two laws' reading of a log's voltage lines: Λ as a back-EMF, as a dead time.
+    fn law(emf_lambda: f64, dead_time_lambda: f64) -> EmfLaw {
+        EmfLaw {
+            emf_lambda,
+            dead_time_lambda,
+            dead_time_s: 1.06e-6,
+            band: 3,
+        }
+    }
+
     #[test]
     fn the_law_that_explains_the_voltage_lines_better_names_them() {
-        // A dead time's lines: 4599 as its own law (1 dof) against 2543 as a back-EMF's
-        // (4 dof). The flux harmonics are vetoed whatever their Λ on the torque line, and
-        // both dead-time readings stand (the stronger is named).
-        let law = EmfLaw {
-            emf_lambda: 2542.7,
-            dead_time_lambda: 4598.6,
-            dead_time_s: 1.06e-6,
-            band_a: 0.2,
-        };
-        let mut t = tested(law);
+        // A dead time's lines as a blind log read them: 4599 as its own law (1 dof) against 2543 as a
+        // back-EMF's (4 dof). The flux harmonics are vetoed whatever their Λ on the torque
+        // line, and both dead-time readings stand (the stronger is named).
+        let mut t = tested(law(2542.7, 4598.6));
         apply_vetoes(&mut t);
         assert!(t[1].veto.is_some() && t[0].veto.is_none() && t[2].veto.is_none());
         assert_eq!(decide(&t), Some(2));
-        // A back-EMF's lines: every dead-time reading is vetoed.
-        let law = EmfLaw {
-            emf_lambda: 632.0,
-            dead_time_lambda: 25.2,
-            dead_time_s: 5.0e-7,
-            band_a: 0.8,
-        };
-        let mut t = tested(law);
+        // A flux harmonics' back-EMF lines: every dead-time reading is vetoed.
+        let mut t = tested(law(632.0, 25.2));
         apply_vetoes(&mut t);
         assert!(t[1].veto.is_none() && t[0].veto.is_some() && t[2].veto.is_some());
         assert_eq!(decide(&t), Some(1));
         // Within the margin the extra three degrees of freedom cost: 4 dof need 8.4 more.
-        let law = EmfLaw {
-            emf_lambda: 100.0 + threshold(4) - threshold(1) - 1.0,
-            dead_time_lambda: 100.0,
-            dead_time_s: 1e-6,
-            band_a: 0.2,
-        };
-        let mut t = tested(law);
+        let mut t = tested(law(100.0 + threshold(4) - threshold(1) - 1.0, 100.0));
         apply_vetoes(&mut t);
         assert!(t[1].veto.is_some(), "{:?}", t[1].veto);
     }

@@ -22,7 +22,7 @@
 //! are of the same residuals; each is compared with its own χ² quantile (4 and 1 degrees
 //! of freedom) in [`super::decision::apply_vetoes`].
 
-use crate::diagnose::back_emf::LineObservation;
+use crate::diagnose::back_emf::{weighted_amplitude, LineObservation};
 use crate::diagnose::lines::{DEAD_TIME_BANDS_A, REFERENCE_DEAD_TIME_S};
 use rustfft::num_complex::Complex64;
 
@@ -47,92 +47,82 @@ pub struct EmfLaw {
     pub dead_time_lambda: f64,
     /// The dead time that law fits. [s]
     pub dead_time_s: f64,
-    /// Its fade band. [A]
-    pub band_a: f64,
+    /// Its fade band, as an index into [`DEAD_TIME_BANDS_A`].
+    pub band: usize,
 }
 
 /// Λ of one complex amplitude per axis of the back-EMF's law.
 fn emf_lambda(lines: &[EmfLine]) -> f64 {
     [false, true]
         .iter()
-        .map(|&d| {
-            let (mut info, mut score) = (0.0, Complex64::default());
-            for l in lines.iter().filter(|l| l.d_axis == d) {
-                info += l.of.regressor.norm_sqr() / l.of.var;
-                score += l.of.regressor.conj() * l.of.line / l.of.var;
-            }
-            if info > 0.0 {
-                score.norm_sqr() / info
-            } else {
-                0.0
-            }
+        .filter_map(|&d| {
+            let axis = lines.iter().filter(move |l| l.d_axis == d).map(|l| &l.of);
+            weighted_amplitude(axis).map(|(a, info)| a.norm_sqr() * info)
         })
         .sum()
 }
 
-/// The dead time's scale (in units of the reference) and Λ at fade band `b`, the scale
-/// kept non-negative (a dead time only takes voltage away).
-fn dead_time_fit(lines: &[EmfLine], b: usize) -> (f64, f64) {
+/// The dead time's scale (in units of the reference) and Λ at fade band `b`: the scale
+/// kept non-negative (a dead time only takes voltage away), and no reading (Λ = 0) where
+/// it would pass `max_scale` (a light load's vanishing model line).
+fn dead_time_fit(lines: &[EmfLine], b: usize, max_scale: f64) -> (f64, f64) {
     let (mut info, mut score) = (0.0, 0.0);
     for l in lines {
         let x = -l.dead_time[b];
         info += x.norm_sqr() / l.of.var;
         score += (x.conj() * l.of.line).re / l.of.var;
     }
-    if info > 0.0 && score > 0.0 {
+    if info > 0.0 && score > 0.0 && score / info <= max_scale {
         (score / info, score * score / info)
     } else {
         (0.0, 0.0)
     }
 }
 
-/// Both laws on `lines`; `None` without a line of finite positive variance.
-pub fn emf_law(lines: &[EmfLine]) -> Option<EmfLaw> {
-    let usable: Vec<EmfLine> = lines
-        .iter()
-        .filter(|l| l.of.var > 0.0 && l.of.var.is_finite())
-        .copied()
-        .collect();
+/// Both laws on `lines`, the dead time read up to `max_scale` references
+/// ([`crate::diagnose::dead_time::max_scale`]); `None` without a line of finite positive
+/// variance.
+pub fn emf_law(lines: &[EmfLine], max_scale: f64) -> Option<EmfLaw> {
+    let usable: Vec<EmfLine> = lines.iter().filter(|l| usable(l)).copied().collect();
     if usable.is_empty() {
         return None;
     }
-    let (b, (scale, lambda)) = (0..DEAD_TIME_BANDS_A.len())
-        .map(|b| (b, dead_time_fit(&usable, b)))
+    let (band, (scale, lambda)) = (0..DEAD_TIME_BANDS_A.len())
+        .map(|b| (b, dead_time_fit(&usable, b, max_scale)))
         .max_by(|x, y| x.1 .1.total_cmp(&y.1 .1))?;
     Some(EmfLaw {
         emf_lambda: emf_lambda(&usable),
         dead_time_lambda: lambda,
         dead_time_s: scale * REFERENCE_DEAD_TIME_S,
-        band_a: DEAD_TIME_BANDS_A[b],
+        band,
     })
 }
 
+/// A line with a finite positive variance.
+fn usable(l: &EmfLine) -> bool {
+    l.of.var > 0.0 && l.of.var.is_finite()
+}
+
 impl EmfLaw {
-    /// The line this law's dead time predicts on `line`'s axis. [V]
-    fn predicted(&self, line: &EmfLine) -> Complex64 {
-        let b = DEAD_TIME_BANDS_A
-            .iter()
-            .position(|x| *x == self.band_a)
-            .unwrap_or(0);
-        -line.dead_time[b] * (self.dead_time_s / REFERENCE_DEAD_TIME_S)
+    /// The fade band of the dead time's law. [A]
+    pub fn band_a(&self) -> f64 {
+        DEAD_TIME_BANDS_A[self.band]
     }
 
     /// How much of the line power of `lines` (another segment's) this law's dead time
     /// predicts: Σ (|y|² − |y − ŷ|²)/σ², positive when its lines are there; `None` without
     /// a line. [1]
     pub fn gain(&self, lines: &[EmfLine]) -> Option<f64> {
-        let usable = lines
+        let scale = self.dead_time_s / REFERENCE_DEAD_TIME_S;
+        let gains: Vec<f64> = lines
             .iter()
-            .filter(|l| l.of.var > 0.0 && l.of.var.is_finite());
-        let mut n = 0;
-        let gain = usable
+            .filter(|l| usable(l))
             .map(|l| {
-                n += 1;
-                let y = l.of.line;
-                (y.norm_sqr() - (y - self.predicted(l)).norm_sqr()) / l.of.var
+                let (y, predicted) = (l.of.line, -l.dead_time[self.band] * scale);
+                (y.norm_sqr() - (y - predicted).norm_sqr()) / l.of.var
             })
-            .sum();
-        (n > 0).then_some(gain)
+            .collect();
+        (!gains.is_empty()).then(|| gains.iter().sum())
     }
 }
 
@@ -202,13 +192,19 @@ mod tests {
     #[test]
     fn a_dead_times_lines_fit_its_own_law_and_are_read_back_at_its_size() {
         // 1.5 µs of dead time: Y = −1.5·U_dt(1 µs), whatever the speed.
-        let law = emf_law(&lines(&[6.0, 7.5, 40.0], &[1.0, 1.2, 0.6], |dt, _| {
+        let lines = lines(&[6.0, 7.5, 40.0], &[1.0, 1.2, 0.6], |dt, _| {
             dt.map(|z| -1.5 * z)
-        }))
-        .unwrap();
+        });
+        let law = emf_law(&lines, 5.0).unwrap();
         assert!((law.dead_time_s - 1.5e-6).abs() < 1e-12, "{law:?}");
-        assert_eq!(law.band_a, 0.1);
+        assert_eq!(law.band_a(), 0.1);
         assert!(law.dead_time_lambda > law.emf_lambda + 10.0, "{law:?}");
+        // Its prediction is the lines themselves: the gain on them is their whole power.
+        let power: f64 = lines.iter().map(|l| l.of.line.norm_sqr() / l.of.var).sum();
+        let gain = law.gain(&lines).unwrap();
+        assert!((gain - power).abs() < 1e-9 * power, "{gain} vs {power}");
+        // A dead time beyond the plausible bound is no reading.
+        assert_eq!(emf_law(&lines, 1.0).unwrap().dead_time_lambda, 0.0);
     }
 
     #[test]
@@ -218,9 +214,12 @@ mod tests {
             Complex64::from_polar(0.01, 0.4),
             Complex64::from_polar(0.006, -1.2),
         );
-        let law = emf_law(&lines(&[6.0, 7.5, 40.0], &[1.0, 1.2, 0.6], |_, w| {
-            [0.72 * w * b, -0.72 * w * a]
-        }))
+        let law = emf_law(
+            &lines(&[6.0, 7.5, 40.0], &[1.0, 1.2, 0.6], |_, w| {
+                [0.72 * w * b, -0.72 * w * a]
+            }),
+            5.0,
+        )
         .unwrap();
         let power = [6.0f64, 7.5, 40.0]
             .iter()

@@ -332,13 +332,13 @@ impl Hydraulics {
         // reading of it in true pressure.
         let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
         // The transducer's step factor 1 − e^(−h/τ) of each substep length met.
-        let mut lag = LagFactors::new(hp.sensor_lag_s);
+        let mut lags = LagFactors::new(hp.sensor_lag_s);
         for k in rows.start..rows.end.saturating_sub(1) {
             let next = k + 1;
             let dt = x.t_s[next] - x.t_s[k];
             let steps = ((dt / MAX_SUBSTEP_S).ceil() as usize).max(1);
             let h = dt / steps as f64;
-            let lag = lag.at(h);
+            let lag = lags.at(h);
             let dtheta = x.theta_rad[next] - x.theta_rad[k];
             let (x0, dx) = match x.x_m {
                 Some(xm) => (xm[k], xm[next] - xm[k]),
