@@ -5,7 +5,7 @@
 
 use plant_model::pump::ripple_order;
 use plant_model::Rig;
-use rustfft::{num_complex::Complex, FftPlanner};
+use rustfft::{num_complex::Complex, FftPlannerScalar};
 
 /// A source of periodic pulsation, by order.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,7 +81,9 @@ pub fn amplitude_spectrum(x: &[f64], dt_s: f64) -> Vec<(f64, f64)> {
             Complex::new((v - xm - slope * (i as f64 - tm)) * w, 0.0)
         })
         .collect();
-    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    FftPlannerScalar::new()
+        .plan_fft_forward(n)
+        .process(&mut buf);
     let df = 1.0 / (nf * dt_s);
     buf.iter()
         .take(n / 2)

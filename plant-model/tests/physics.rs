@@ -8,7 +8,7 @@ use plant_model::motor::Motor;
 use plant_model::pump::Pump;
 use plant_model::rig::FluxHarmonic;
 use plant_model::{Drive, Effect, InitialConditions, Inputs, Integrator, Plant, Rig};
-use rustfft::{num_complex::Complex, FftPlanner};
+use rustfft::{num_complex::Complex, FftPlannerScalar};
 use std::f64::consts::PI;
 
 const SQRT3: f64 = 1.732_050_807_568_877_2;
@@ -17,7 +17,9 @@ const SQRT3: f64 = 1.732_050_807_568_877_2;
 fn amplitude_spectrum(samples: &[f64]) -> Vec<f64> {
     let n = samples.len();
     let mut buf: Vec<Complex<f64>> = samples.iter().map(|&x| Complex::new(x, 0.0)).collect();
-    FftPlanner::new().plan_fft_forward(n).process(&mut buf);
+    FftPlannerScalar::new()
+        .plan_fft_forward(n)
+        .process(&mut buf);
     buf.iter()
         .take(n / 2)
         .enumerate()

@@ -23,7 +23,7 @@ use plant_model::motor::Motor;
 use plant_model::pump::Pump;
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
-use rustfft::FftPlanner;
+use rustfft::FftPlannerScalar;
 use std::f64::consts::PI;
 
 /// Samples per revolution of the harmonic decompositions. [1]
@@ -35,7 +35,9 @@ pub fn harmonics_of(f: impl Fn(f64) -> f64, floor: f64) -> Vec<Harmonic> {
     let mut buf: Vec<Complex64> = (0..FINE)
         .map(|i| Complex64::new(f(2.0 * PI * i as f64 / FINE as f64), 0.0))
         .collect();
-    FftPlanner::new().plan_fft_forward(FINE).process(&mut buf);
+    FftPlannerScalar::new()
+        .plan_fft_forward(FINE)
+        .process(&mut buf);
     let mut out: Vec<Harmonic> = (0..=MAX_ORDER as usize)
         .map(|k| Harmonic {
             order: k as u32,

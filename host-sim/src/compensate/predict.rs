@@ -19,7 +19,7 @@ use closed_loop::{by_name, Scenario};
 use plant_model::Rig;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
-use rustfft::FftPlanner;
+use rustfft::FftPlannerScalar;
 use serde::Serialize;
 
 /// Length of a prediction's holding run: 15 s steady, about 13 revolutions at the
@@ -111,7 +111,7 @@ pub fn angle_locked_pp(theta: &[f64], y: &[f64]) -> f64 {
         .zip(&n)
         .map(|(s, c)| Complex64::new(s / *c as f64, 0.0))
         .collect();
-    let mut planner = FftPlanner::new();
+    let mut planner = FftPlannerScalar::new();
     planner.plan_fft_forward(ANGLE_BINS).process(&mut buf);
     for (k, c) in buf.iter_mut().enumerate() {
         if k.min(ANGLE_BINS - k) < MIN_LOCKED_ORDER {

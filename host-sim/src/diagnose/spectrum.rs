@@ -5,7 +5,7 @@
 //! (1st electrical), 5th/7th flux harmonics at 6·p_n, cogging at LCM(slots, 2·p_n), piston
 //! ripple at z or 2z (eq. 16–21).
 
-use rustfft::{num_complex::Complex, FftPlanner};
+use rustfft::{num_complex::Complex, FftPlannerScalar};
 use std::f64::consts::PI;
 
 /// Samples per revolution of the resampled residual (orders up to half of it are seen).
@@ -89,7 +89,9 @@ pub fn order_spectrum(theta: &[f64], residual: &[f64]) -> Option<OrderSpectrum> 
     for c in &mut buf {
         c.re -= mean;
     }
-    FftPlanner::new().plan_fft_forward(m).process(&mut buf);
+    FftPlannerScalar::new()
+        .plan_fft_forward(m)
+        .process(&mut buf);
     let amplitude = (0..=SAMPLES_PER_REV / 2)
         .map(|k| {
             let bin = k * revolutions;
