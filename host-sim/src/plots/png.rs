@@ -1,7 +1,8 @@
 //! PNG beside every SVG plot, rendered in-process with resvg (no external tool at run
 //! time), so a report reads in any image viewer. Text is set in the system's sans-serif
 //! face (DejaVu Sans, Liberation Sans, Noto Sans, Arial or Helvetica, whichever is found
-//! first; fontdb reads the system's font folders once per process).
+//! first; fontdb reads the system's font folders once per process, and maps a face's file
+//! each time text is set in it rather than reading the whole file again).
 
 use resvg::tiny_skia::{Pixmap, Transform};
 use resvg::usvg::{self, fontdb};
