@@ -18,7 +18,7 @@
 //! a voltage disturbance moving current and angle together cannot pass for a torque.
 
 use crate::diagnose::back_emf::{
-    back_emf_lines, voltage_lines, weighted_amplitude, LineObservation, Stator,
+    back_emf_lines, explained_power, voltage_lines, weighted_amplitude, LineObservation, Stator,
 };
 use crate::diagnose::emf_law::{emf_law, EmfLaw, EmfLine};
 use crate::diagnose::lines::{OrderLines, WindowLines, DEAD_TIME_BANDS_A};
@@ -348,7 +348,7 @@ pub fn line_gain(
             } else {
                 fit.amplitude * o.regressor
             };
-            (o.line.norm_sqr() - (o.line - predicted).norm_sqr()) / o.var
+            explained_power(o.line, predicted, o.var)
         })
         .sum();
     LineValidation {

@@ -81,6 +81,14 @@ pub fn weighted_amplitude<'a>(
     })
 }
 
+/// The power of a measured line `y` that a predicted line `predicted` explains, over the
+/// line's noise variance `var`: (|y|² − |y − ŷ|²)/σ², the likelihood ratio's share of one
+/// line (negative where the prediction is worse than none). [1]
+#[inline]
+pub fn explained_power(y: Complex64, predicted: Complex64, var: f64) -> f64 {
+    (y.norm_sqr() - (y - predicted).norm_sqr()) / var
+}
+
 /// Relative uncertainty of the calibrated resistance, inductances and flux linkage in the
 /// voltage lines: R, L and ψ_f in that order (winding temperature, saturation, magnets). [1]
 pub const STATOR_TOLERANCE: [f64; 3] = [0.2, 0.1, 0.05];

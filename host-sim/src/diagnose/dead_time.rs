@@ -25,6 +25,7 @@
 //! the fade band searched over a grid (it is not in the rig contract). Without the angle
 //! the phases are not placed: the magnitudes at the window's mean current.
 
+use crate::diagnose::back_emf::explained_power;
 use crate::diagnose::lines::{OrderLines, WindowLines};
 use crate::diagnose::loop_response::{
     current_tracking, disturbance_sensitivity, speed_reference_per_angle, LOOP_TOLERANCE,
@@ -208,10 +209,7 @@ pub fn fit_dead_time(lines: &[&WindowLines], rig: &Rig, candidates: &[u32]) -> O
 fn explained(obs: &[Obs], scale: f64, weight: fn(&Obs, usize) -> f64) -> f64 {
     obs.iter()
         .flat_map(|o| {
-            (0..2).map(move |a| {
-                (o.measured[a].norm_sqr() - (o.measured[a] - o.model[a] * scale).norm_sqr())
-                    / weight(o, a)
-            })
+            (0..2).map(move |a| explained_power(o.measured[a], o.model[a] * scale, weight(o, a)))
         })
         .sum::<f64>()
 }

@@ -22,7 +22,7 @@
 //! are of the same residuals; each is compared with its own χ² quantile (4 and 1 degrees
 //! of freedom) in [`super::decision::apply_vetoes`].
 
-use crate::diagnose::back_emf::{weighted_amplitude, LineObservation};
+use crate::diagnose::back_emf::{explained_power, weighted_amplitude, LineObservation};
 use crate::diagnose::lines::{DEAD_TIME_BANDS_A, REFERENCE_DEAD_TIME_S};
 use rustfft::num_complex::Complex64;
 
@@ -114,15 +114,12 @@ impl EmfLaw {
     /// a line. [1]
     pub fn gain(&self, lines: &[EmfLine]) -> Option<f64> {
         let scale = self.dead_time_s / REFERENCE_DEAD_TIME_S;
-        let gains: Vec<f64> = lines
+        let (n, gain) = lines
             .iter()
             .filter(|l| usable(l))
-            .map(|l| {
-                let (y, predicted) = (l.of.line, -l.dead_time[self.band] * scale);
-                (y.norm_sqr() - (y - predicted).norm_sqr()) / l.of.var
-            })
-            .collect();
-        (!gains.is_empty()).then(|| gains.iter().sum())
+            .map(|l| explained_power(l.of.line, -l.dead_time[self.band] * scale, l.of.var))
+            .fold((0, 0.0), |(n, sum), g| (n + 1, sum + g));
+        (n > 0).then_some(gain)
     }
 }
 
