@@ -197,7 +197,7 @@ fn test_relations(
                                 cylinder::ix::ZERO,
                                 y.relation.strokes_both_ways(),
                             );
-                            let mut tested = from_release(&y, &t, &r.m_val, rig);
+                            let mut tested = from_release(&y, &t, &r.m_id, &r.m_val, rig);
                             if at_zero {
                                 tested.evidence.push_str(&y.relation.zero_caveat());
                             }

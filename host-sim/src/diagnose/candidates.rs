@@ -36,6 +36,7 @@ use crate::diagnose::hydraulic_relation::hyd;
 use crate::diagnose::least_squares::ParamSpec;
 use crate::diagnose::lines::WindowLines;
 use crate::diagnose::mechanical_relation::mech;
+use crate::diagnose::validation_spread::validation_spread;
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::Rig;
 use std::ops::Range;
@@ -82,6 +83,9 @@ pub struct Tested {
     pub outside_band: bool,
     /// Gain on the validation segment, same units as `lambda` (`None`: nothing to score).
     pub validation_gain: Option<f64>,
+    /// Standard error of a validation loss from the two fits' parameter uncertainty, same
+    /// units (`None`: not a loss, or not a relation's test).
+    pub validation_spread: Option<f64>,
     /// A structural reason it cannot be the cause, when one holds.
     pub veto: Option<String>,
     /// What was measured, in words.
@@ -113,6 +117,7 @@ impl Tested {
             dof,
             outside_band: true,
             validation_gain: None,
+            validation_spread: None,
             veto: None,
             evidence: String::new(),
             extension,
@@ -158,9 +163,14 @@ fn released_effect(release: Release, v: &[f64]) -> (&'static [usize], &'static s
 pub const SEARCH_EDGE: f64 = 0.02;
 
 /// A released parameter's test in the catalogue's terms.
+///
+/// `identification` holds the rows the test was fitted on: a loss on the `validation` rows
+/// is weighed against the spread the two fits' uncertainty there gives it
+/// ([`validation_spread`]).
 pub fn from_release<R: Relation>(
     relation: &R,
     test: &ReleaseTest,
+    identification: &[Range<usize>],
     validation: &[Range<usize>],
     rig: &Rig,
 ) -> Tested {
@@ -212,6 +222,17 @@ pub fn from_release<R: Relation>(
         weighed_sse(relation, &test.baseline.values, validation, test.scale)
             - weighed_sse(relation, &test.fitted.values, validation, test.scale)
     });
+    // Where the validation segment reads a loss: how far the two fits' own uncertainty
+    // could move it.
+    let validation_spread = match validation_gain {
+        Some(g) if g < 0.0 => {
+            let spread = |specs: &[ParamSpec], u: &[f64]| {
+                validation_spread(relation, specs, u, identification, validation, test.scale)
+            };
+            Some(spread(&base_specs, &test.baseline.u).hypot(spread(&specs, &test.fitted.u)))
+        }
+        _ => None,
+    };
     // Each reported parameter's spread at one standard error of the coordinate it was
     // searched in (the catalogue's value moves with the search value one to one but for an
     // additive nominal: the leakage's, the cylinder's friction levels).
@@ -244,6 +265,14 @@ pub fn from_release<R: Relation>(
             main.value(u)
         )
     });
+    let mut evidence = release_evidence(test, &indices, &specs, &base_specs);
+    if let (Some(g), Some(s)) = (validation_gain, validation_spread) {
+        evidence.push_str(&format!(
+            "; the validation segment reads a loss of {:.1} with a spread of {:.1} from where \
+             the two fits stopped along the directions the identification leaves flat",
+            -g, s
+        ));
+    }
     Tested {
         effect,
         parameters,
@@ -251,8 +280,9 @@ pub fn from_release<R: Relation>(
         dof: indices.len(),
         outside_band,
         validation_gain,
+        validation_spread,
         veto,
-        evidence: release_evidence(test, &indices, &specs, &base_specs),
+        evidence,
         extension,
         standard_errors,
         release: test.release,
@@ -346,7 +376,7 @@ pub fn test_relation<R: Relation>(
         .iter()
         .map(|r| {
             let t = test_release(relation, identification, *r, calibration);
-            from_release(relation, &t, validation, rig)
+            from_release(relation, &t, identification, validation, rig)
         })
         .collect()
 }
@@ -489,6 +519,7 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         dof: f.dof,
         outside_band: a - 2.0 * se > floor,
         validation_gain,
+        validation_spread: None,
         veto: None,
         evidence,
         extension: Extension::TorqueLine(f),
@@ -522,6 +553,7 @@ pub fn dead_time_tested(
         dof: 1,
         outside_band: law.dead_time_s - 2.0 * se > DEAD_TIME_BAND_S,
         validation_gain: law.gain(validation),
+        validation_spread: None,
         veto: None,
         evidence: format!(
             "d and q voltage lines at order 6·p_n over {windows} steady window(s) as an \
@@ -553,6 +585,7 @@ fn dead_time_verdict(f: DeadTimeFit, validation_gain: Option<f64>, windows: usiz
         dof: 1,
         outside_band: f.dead_time_s - 2.0 * se_scale > DEAD_TIME_BAND_S,
         validation_gain,
+        validation_spread: None,
         veto: None,
         evidence,
         extension: Extension::CurrentLines(f),

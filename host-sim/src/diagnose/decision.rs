@@ -17,7 +17,13 @@
 //!    validation segment significantly worse (its gain there, in the same χ² units, above
 //!    −[`VALIDATION_TOLERANCE`]): an effect the validation segment excites must improve it
 //!    or be refuted; one it does not excite (a bulk modulus seen only in a fill below the
-//!    precharge) cannot be confirmed there and stands on its identification evidence.
+//!    precharge) cannot be confirmed there and stands on its identification evidence. A
+//!    loss is weighed against its spread ([`crate::diagnose::validation_spread`]): each fit
+//!    extrapolates with its tolerances where the identification left them, and along a
+//!    direction the identification leaves flat (a misfitting baseline bends its tolerances
+//!    to absorb the misfit) that end point, and the loss with it, is arbitrary. A loss
+//!    within [`SPREAD_QUANTILE`] standard errors of the tolerance does not refute an effect
+//!    whose Λ exceeds that reach ([`loss_inconclusive`]).
 //! 4. **No structural veto.** A dead time and the flux harmonics share the lines at order
 //!    6·p_n: only the one that explains them better is named ([`apply_vetoes`]).
 //!
@@ -33,6 +39,21 @@ pub const FALSE_ALARM: f64 = 1e-4;
 /// How much worse the validation segment may get under an extension before it refutes it:
 /// the χ²(1) quantile at 95 %. [1]
 pub const VALIDATION_TOLERANCE: f64 = 3.84;
+
+/// Standard errors of a validation loss within which the validation segment cannot tell
+/// the extension from the baseline: the normal distribution's two-sided 95 % quantile. [1]
+pub const SPREAD_QUANTILE: f64 = 1.96;
+
+/// Whether the validation loss `g` of `t` lies within what the two fits' own parameter
+/// uncertainty makes of it (within [`SPREAD_QUANTILE`] standard errors of the tolerance)
+/// while the identification's evidence, Λ, is larger than that uncertainty: the
+/// validation segment then cannot refute what the identification shows.
+pub fn loss_inconclusive(t: &Tested, g: f64) -> bool {
+    t.validation_spread.is_some_and(|s| {
+        let reach = SPREAD_QUANTILE * s;
+        g + reach >= -VALIDATION_TOLERANCE && t.lambda >= reach
+    })
+}
 
 /// The χ² threshold at [`FALSE_ALARM`] for `dof` degrees of freedom.
 pub fn threshold(dof: usize) -> f64 {
@@ -54,7 +75,7 @@ pub fn why_not(t: &Tested) -> Option<String> {
         return Some("within its tolerance band".into());
     }
     if let Some(g) = t.validation_gain {
-        if g < -VALIDATION_TOLERANCE {
+        if g < -VALIDATION_TOLERANCE && !loss_inconclusive(t, g) {
             return Some(format!("the validation segment refutes it (gain {g:.1})"));
         }
     }
@@ -203,6 +224,27 @@ mod tests {
         let mut t = tested(law(100.0 + threshold(4) - threshold(1) - 1.0, 100.0));
         apply_vetoes(&mut t);
         assert!(t[1].veto.is_some(), "{:?}", t[1].veto);
+    }
+
+    #[test]
+    fn a_validation_loss_within_the_fits_spread_does_not_refute_strong_evidence() {
+        // Λ 150 000, a loss of 98 with a spread of 160: −98 + 1.96·160 = 215.6 lies above
+        // −3.84 and Λ above the reach 313.6: the validation cannot tell, the effect stands.
+        let mut t = Tested::bare("entrained_air", 150_000.0, 1, Extension::Hydraulic(vec![]));
+        t.validation_gain = Some(-98.0);
+        t.validation_spread = Some(160.0);
+        assert!(why_not(&t).is_none(), "{:?}", why_not(&t));
+        // A spread of 40: −98 + 78.4 = −19.6 lies below −3.84, a conclusive loss.
+        t.validation_spread = Some(40.0);
+        assert!(why_not(&t).is_some_and(|w| w.contains("refutes")));
+        // No spread known: the loss refutes as it reads.
+        t.validation_spread = None;
+        assert!(why_not(&t).is_some_and(|w| w.contains("refutes")));
+        // Weak evidence inside a wide spread: Λ 32 under the reach 1.96·137 = 268.5.
+        let mut w = Tested::bare("pressure_sensor_lag", 32.0, 1, Extension::Hydraulic(vec![]));
+        w.validation_gain = Some(-35.0);
+        w.validation_spread = Some(137.0);
+        assert!(why_not(&w).is_some_and(|w| w.contains("refutes")));
     }
 
     #[test]

@@ -69,6 +69,7 @@ pub mod stick;
 #[cfg(test)]
 mod test_noise;
 pub mod unseen_motion;
+pub mod validation_spread;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};
 

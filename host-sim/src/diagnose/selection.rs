@@ -179,7 +179,7 @@ fn judged<R: Relation>(
     rig: &Rig,
 ) -> Tested {
     let t = test_release(relation, &rel.h_id, release, base);
-    let mut tested = from_release(relation, &t, &rel.h_val, rig);
+    let mut tested = from_release(relation, &t, &rel.h_id, &rel.h_val, rig);
     tested
         .evidence
         .push_str(" (against the model with the other named effects)");
