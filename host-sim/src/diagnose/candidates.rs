@@ -257,14 +257,26 @@ pub fn from_release<R: Relation>(
     let (lo, hi) = main.u_bounds;
     let u = test.fitted.u[indices[0]];
     let at_top = hi > lo && hi - u <= SEARCH_EDGE * (hi - lo);
-    let veto = (test.release == Release::SensorLag && at_top).then(|| {
-        format!(
+    // Entrained air only softens the oil (the catalogue's effect is a bulk modulus below the
+    // rig file's): a reading above the band is a stiffness the log trades against the line
+    // volume or another tolerance, not air.
+    let above_band = base_specs[indices[0]].band.is_some_and(|(_, top)| u > top);
+    let veto = if test.release == Release::SensorLag && at_top {
+        Some(format!(
             "its fit ran to the edge of the plausible range ({} = {:.4e}): the log asks for \
              more than this effect can be, a mismatch of another kind",
             main.name,
             main.value(u)
-        )
-    });
+        ))
+    } else if test.release == Release::BulkModulus && above_band {
+        Some(format!(
+            "its bulk modulus reads above its band ({:.4e} Pa): air only softens the oil, so \
+             a stiffer reading is a volume or a tolerance the log does not separate, not air",
+            main.value(u)
+        ))
+    } else {
+        None
+    };
     let mut evidence = release_evidence(test, &indices, &specs, &base_specs);
     if let (Some(g), Some(s)) = (validation_gain, validation_spread) {
         evidence.push_str(&format!(
