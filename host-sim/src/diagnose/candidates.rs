@@ -36,7 +36,7 @@ use crate::diagnose::hydraulic_relation::hyd;
 use crate::diagnose::least_squares::ParamSpec;
 use crate::diagnose::lines::WindowLines;
 use crate::diagnose::mechanical_relation::mech;
-use crate::diagnose::validation_spread::validation_spread;
+use crate::diagnose::validation_spread::{validation_spread, VALIDATION_TOLERANCE};
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::Rig;
 use std::ops::Range;
@@ -222,10 +222,10 @@ pub fn from_release<R: Relation>(
         weighed_sse(relation, &test.baseline.values, validation, test.scale)
             - weighed_sse(relation, &test.fitted.values, validation, test.scale)
     });
-    // Where the validation segment reads a loss: how far the two fits' own uncertainty
-    // could move it.
+    // Where the validation segment reads a loss beyond its tolerance: how far the two fits'
+    // own uncertainty could move it.
     let validation_spread = match validation_gain {
-        Some(g) if g < 0.0 => {
+        Some(g) if g < -VALIDATION_TOLERANCE => {
             let spread = |specs: &[ParamSpec], u: &[f64]| {
                 validation_spread(relation, specs, u, identification, validation, test.scale)
             };

@@ -36,9 +36,7 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 /// the whole catalogue under the nominal model). [1]
 pub const FALSE_ALARM: f64 = 1e-4;
 
-/// How much worse the validation segment may get under an extension before it refutes it:
-/// the χ²(1) quantile at 95 %. [1]
-pub const VALIDATION_TOLERANCE: f64 = 3.84;
+pub use crate::diagnose::validation_spread::VALIDATION_TOLERANCE;
 
 /// Standard errors of a validation loss within which the validation segment cannot tell
 /// the extension from the baseline: the normal distribution's two-sided 95 % quantile. [1]

@@ -164,6 +164,27 @@ pub fn fit_with_patience<M: Model>(model: &M, specs: &[ParamSpec], patience: usi
     }
 }
 
+/// The Gauss–Newton information JᵀJ of the residuals' difference columns `columns` (each
+/// `m` long, one for each parameter of `free`, an index into `specs`), with each such
+/// parameter's Gaussian prior, 1/sd², on its diagonal.
+pub fn information(
+    columns: &[Vec<f64>],
+    m: usize,
+    specs: &[ParamSpec],
+    free: &[usize],
+) -> DMatrix<f64> {
+    let f = free.len();
+    let mut jtj = DMatrix::from_fn(f, f, |i, j| {
+        (0..m).map(|r| columns[i][r] * columns[j][r]).sum::<f64>()
+    });
+    for (i, &k) in free.iter().enumerate() {
+        if let Some((_, sd)) = specs[k].prior {
+            jtj[(i, i)] += 1.0 / (sd * sd);
+        }
+    }
+    jtj
+}
+
 /// (JᵀJ)⁻¹ in u at `u` (data and prior rows), by central differences kept inside the
 /// bounds, over the parameters off their bounds: one held at a bound by the data is
 /// fixed there (the reduced Hessian of a bound-constrained problem), its row and column
@@ -214,17 +235,7 @@ fn covariance<M: Model>(
                 .collect()
         })
         .collect();
-    let m = r0.len();
-    let f = free.len();
-    let mut jtj = DMatrix::from_fn(f, f, |i, j| {
-        (0..m).map(|r| columns[i][r] * columns[j][r]).sum::<f64>()
-    });
-    for (i, &k) in free.iter().enumerate() {
-        if let Some((_, sd)) = specs[k].prior {
-            jtj[(i, i)] += 1.0 / (sd * sd);
-        }
-    }
-    let inv = jtj.try_inverse()?;
+    let inv = information(&columns, r0.len(), specs, &free).try_inverse()?;
     let mut full = DMatrix::zeros(n, n);
     for (i, &a) in free.iter().enumerate() {
         for (j, &b) in free.iter().enumerate() {

@@ -14,9 +14,13 @@
 //! both fits is then √(g_bᵀH_b⁻¹g_b + g_eᵀH_e⁻¹g_e).
 
 use crate::diagnose::calibration::{weighed_sse, Relation};
-use crate::diagnose::least_squares::{variance_per_independent_sample, ParamSpec};
-use nalgebra::{DMatrix, DVector};
+use crate::diagnose::least_squares::{information, variance_per_independent_sample, ParamSpec};
+use nalgebra::DVector;
 use std::ops::Range;
+
+/// How much worse the validation segment may get under an extension before it refutes it:
+/// the χ²(1) quantile at 95 %. A loss beyond it is given its spread. [1]
+pub const VALIDATION_TOLERANCE: f64 = 3.84;
 
 /// Share of a parameter's search range its difference quotients step by. [1]
 const STEP: f64 = 1e-3;
@@ -45,18 +49,10 @@ pub fn validation_spread<R: Relation>(
     if n == 0 {
         return 0.0;
     }
-    // The difference quotients in single precision, column by column: the identification
-    // rows of a fit (up to a dozen seconds of log) times its parameters, half the memory
-    // of doubles, and the spread needs no more than a few digits.
-    let rows = r0.len();
-    let mut jac = vec![0f32; rows * n];
+    let mut columns = Vec::with_capacity(n);
     let mut g = DVector::<f64>::zeros(n);
-    let mut info = DMatrix::<f64>::zeros(n, n);
     for (k, &i) in free.iter().enumerate() {
         let (lo, hi) = specs[i].u_bounds;
-        let width = hi - lo;
-        info[(k, k)] =
-            12.0 / (width * width) + specs[i].prior.map_or(0.0, |(_, sd)| 1.0 / (sd * sd));
         let mut h = STEP * (hi - lo);
         if u[i] + h > hi {
             h = -h;
@@ -65,28 +61,13 @@ pub fn validation_spread<R: Relation>(
         up[i] += h;
         let vi = values(&up);
         let ri = relation.residuals(&vi, id);
-        let column = &mut jac[k * rows..(k + 1) * rows];
-        for (c, (a, b)) in column.iter_mut().zip(ri.iter().zip(&r0)) {
-            *c = ((a - b) / h * w) as f32;
-        }
+        columns.push(ri.iter().zip(&r0).map(|(a, b)| (a - b) / h * w).collect());
         g[k] = (weighed_sse(relation, &vi, val, scale) - s0) / h;
     }
-    for k in 0..n {
-        for l in 0..=k {
-            let (a, b) = (
-                &jac[k * rows..(k + 1) * rows],
-                &jac[l * rows..(l + 1) * rows],
-            );
-            let dot: f64 = a
-                .iter()
-                .zip(b)
-                .map(|(x, y)| f64::from(*x) * f64::from(*y))
-                .sum();
-            info[(k, l)] += dot;
-            if l != k {
-                info[(l, k)] += dot;
-            }
-        }
+    let mut info = information(&columns, r0.len(), specs, &free);
+    for (k, &i) in free.iter().enumerate() {
+        let (lo, hi) = specs[i].u_bounds;
+        info[(k, k)] += 12.0 / ((hi - lo) * (hi - lo));
     }
     match info.cholesky() {
         Some(c) => g.dot(&c.solve(&g)).max(0.0).sqrt(),
