@@ -206,7 +206,8 @@ impl BenchLog {
             metadata: self.metadata.clone(),
             ..BenchLog::default()
         };
-        for (signal, column) in self.columns() {
+        // A column let go (empty, see [`BenchLog::check_holding`]) stays empty.
+        for (signal, column) in self.columns().filter(|(_, c)| !c.is_empty()) {
             *out.column_mut(signal) = keep.iter().map(|&k| column[k]).collect();
         }
         Some(out)

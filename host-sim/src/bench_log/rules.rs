@@ -15,6 +15,13 @@ impl BenchLog {
     /// Checks the contract's rules on this log as [`super::writer::write`] would lay it out; errors name
     /// the line the offending value would have in the file.
     pub fn check(&self, file: &Path) -> Result<(), BenchLogError> {
+        self.check_holding(file, &[])
+    }
+
+    /// [`BenchLog::check`] for a reader that never reads the columns of `unread` and may
+    /// have let them go once they were checked as read (the diagnosis the pressure
+    /// setpoint): one of them left empty passes; every other column is checked as always.
+    pub fn check_holding(&self, file: &Path, unread: &[Signal]) -> Result<(), BenchLogError> {
         let content = |line: usize, column: &str, problem: Problem| BenchLogError::Content {
             file: file.to_path_buf(),
             line,
@@ -34,6 +41,9 @@ impl BenchLog {
         let header_line = self.metadata.len() + 1;
         let rows = self.len();
         for (s, c) in self.columns() {
+            if c.is_empty() && unread.contains(&s) {
+                continue;
+            }
             if c.len() != rows {
                 return Err(content(
                     header_line,

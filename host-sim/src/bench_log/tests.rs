@@ -343,3 +343,36 @@ fn a_thinned_read_keeps_rows_the_interval_apart_and_still_checks_every_row() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_column_let_go_passes_only_where_the_reader_names_it_unread() {
+    // The setpoint emptied after reading: the full check refuses the log (the column is
+    // shorter than the time's), the check for a reader that never reads it passes, and a
+    // thinning keeps it empty while it thins the others.
+    let mut log = parse_str(&log_text(1000, HEADER, good_row)).unwrap();
+    log.p_ref_pa = Vec::new();
+    let file = Path::new("t.csv");
+    match log.check(file).unwrap_err() {
+        BenchLogError::Content {
+            column, problem, ..
+        } => {
+            assert_eq!(column, "p_ref_pa");
+            assert_eq!(
+                problem,
+                Problem::ColumnLength {
+                    expected: 1000,
+                    found: 0
+                }
+            );
+        }
+        e => panic!("expected a content error, got {e}"),
+    }
+    assert!(log.check_holding(file, &[Signal::PressureRef]).is_ok());
+    // Another column emptied is refused whatever is named unread.
+    let mut short = log.clone();
+    short.iq_a = Vec::new();
+    assert!(short.check_holding(file, &[Signal::PressureRef]).is_err());
+    let thin = log.thinned(2.5e-3).unwrap();
+    assert_eq!((thin.len(), thin.p_ref_pa.len()), (334, 0));
+    assert!(thin.check_holding(file, &[Signal::PressureRef]).is_ok());
+}

@@ -31,7 +31,7 @@ pub use super::relations::Precision;
 use super::relations::{Calibrations, Relations};
 use super::result::{assemble, calibration_values, extended_values, fit_each, fit_of, Scored};
 use super::selection::select;
-use crate::bench_log::BenchLog;
+use crate::bench_log::{BenchLog, Signal};
 use plant_model::Rig;
 use std::path::Path;
 
@@ -216,14 +216,19 @@ fn test_relations(
     tested
 }
 
-/// Runs the whole diagnosis, reporting each finished step to `progress`.
+/// Runs the whole diagnosis, reporting each finished step to `progress`. The diagnosis
+/// explains what the loop did, never what it was asked: `log` may leave the pressure
+/// setpoint's column empty ([`BenchLog::check_holding`]).
 pub fn analyse_reporting(
     log: &BenchLog,
     rig: &Rig,
     precision: Precision,
     progress: &dyn Progress,
 ) -> Result<Analysis, DiagnoseError> {
-    log.check(Path::new("bench log being diagnosed"))?;
+    log.check_holding(
+        Path::new("bench log being diagnosed"),
+        &[Signal::PressureRef],
+    )?;
     rig.validate()?;
     let thinned = log.thinned(MIN_ANALYSED_INTERVAL_S);
     let log = thinned.as_ref().unwrap_or(log);

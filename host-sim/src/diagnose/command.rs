@@ -59,8 +59,10 @@ fn input_or_failure(e: DiagnoseError, log: &std::path::Path) -> CliError {
 
 /// `eha diagnose`.
 pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
-    let (log, rows) = crate::bench_log::read_thinned(&args.log, MIN_ANALYSED_INTERVAL_S)?;
+    let (mut log, rows) = crate::bench_log::read_thinned(&args.log, MIN_ANALYSED_INTERVAL_S)?;
     crate::bench_log::replayable::check(&log, rig, &args.log)?;
+    // The setpoint was checked as it was read; the diagnosis never reads it.
+    log.p_ref_pa = Vec::new();
     let read_as = if rows > log.len() {
         format!(
             " of {rows} rows (a row closer than {:.2} ms to the last one read is skipped)",

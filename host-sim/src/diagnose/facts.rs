@@ -171,7 +171,7 @@ impl LogFacts {
             .flatten();
         let noise_rms: Vec<(Signal, f64)> = log
             .columns()
-            .filter(|(s, _)| *s != Signal::Time)
+            .filter(|(s, y)| *s != Signal::Time && !y.is_empty())
             .map(|(s, y)| (s, noise_rms(y)))
             .collect();
         let p_noise = noise_of(&noise_rms, Signal::Pressure).unwrap_or(0.0);
