@@ -52,11 +52,9 @@ use tests::blind::{
 /// their place in [`COVERAGE`] before any was diagnosed.
 const CI_SEEDS: [u64; 4] = [9, 14, 31, 35];
 
-/// Seeds of the CI part the diagnosis gets wrong today: the suite reports them
-/// and fails when one of them is right (take it out) or any other seed fails. Seed 31, a
-/// sine hiding an inverter dead time and entrained air: the dead time is named, the air's
-/// release stays under its threshold where its fit stops (`docs/diagnosis.md`, Speed).
-const KNOWN_MISSES: [u64; 1] = [31];
+/// Seeds of the CI part the diagnosis gets wrong today (none): the suite reports them
+/// and fails when one of them is right (take it out) or any other seed fails.
+const KNOWN_MISSES: [u64; 0] = [];
 
 /// Least validation-fit gain on a hidden effect's signal. [points]
 const MIN_FIT_GAIN: f64 = 0.0;

@@ -40,7 +40,7 @@
 //! filling at the slope.
 
 use crate::diagnose::facts::{rows_spanning, LogFacts, LowSide};
-use crate::diagnose::lag_factors::{LagFactors, Step};
+use crate::diagnose::lag_factors::{Interval, LagFactors};
 use plant_model::accumulator::{GasCharge, ATMOSPHERE_PA};
 use plant_model::pump::Pump;
 use plant_model::Rig;
@@ -347,14 +347,13 @@ impl Hydraulics {
         // The check valve from the fill holds the port at the fill level: the transducer's
         // reading of it in true pressure.
         let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
-        // The transducer's step factor 1 − e^(−h/τ) of each substep length met.
-        let mut lags = LagFactors::new(hp.sensor_lag_s);
+        // Each log interval's substeps and the transducer's factors over them.
+        let mut intervals = LagFactors::new(hp.sensor_lag_s, substeps);
         for k in rows.start..rows.end.saturating_sub(1) {
             let next = k + 1;
             let dt = x.t_s[next] - x.t_s[k];
-            let steps = substeps(dt);
-            let h = dt / steps as f64;
-            let lag = lags.at(h);
+            let interval = intervals.at(dt);
+            let steps = interval.steps;
             let dtheta = x.theta_rad[next] - x.theta_rad[k];
             let (x0, dx) = match x.x_m {
                 Some(xm) => (xm[k], xm[next] - xm[k]),
@@ -384,7 +383,7 @@ impl Hydraulics {
                     (q_at(factor), c_at(f))
                 };
                 for st in st.iter_mut() {
-                    self.substep(st, h, [q_in, p_low, p_case, floor], c_oil, lag);
+                    self.substep(st, &interval, [q_in, p_low, p_case, floor], c_oil);
                 }
             }
             for (o, st) in out.iter_mut().zip(&st) {
@@ -415,48 +414,55 @@ impl Hydraulics {
         }
     }
 
-    /// One backward-Euler substep of length `h` with inflow `q_in`, see the module docs;
-    /// `lag` is the transducer's step over it (the pressure taken as moving linearly).
+    /// One backward-Euler substep of `step`'s length with inflow `q_in`, see the module
+    /// docs; the transducer follows it with `step`'s factors (the pressure taken as moving
+    /// linearly).
     #[inline]
-    fn substep(&self, st: &mut State, h: f64, flows: [f64; 4], c_oil: f64, lag: Step) {
+    fn substep(&self, st: &mut State, step: &Interval, flows: [f64; 4], c_oil: f64) {
         let [q_in, p_low, p_case, floor] = flows;
+        let h = step.h;
         let hp = &self.params;
         let g = hp.leakage_m3_s_pa;
         let g_pp = self.port_to_port;
         let rhs = c_oil * st.p + h * q_in + h * (g_pp * p_low + (g - g_pp) * p_case);
         let diag = c_oil + h * g;
-        let mut p_new = rhs / diag;
-        if let Some(gas) = &hp.absorber {
-            let p_gas = st.g - ATMOSPHERE_PA;
-            let gas_vol = (gas.shell_volume_m3 - st.v).max(1e-3 * gas.shell_volume_m3);
-            let k_g = gas.exponent * st.g / gas_vol;
-            let den = hp.inlet_inertance_kg_m4 + h * hp.inlet_resistance_pa_s_m3 + h * h * k_g;
-            // q' = a + b·p'.
-            let a = (hp.inlet_inertance_kg_m4 * st.q - h * p_gas) / den;
-            let b = h / den;
-            let p_try = (rhs - h * a) / (diag + h * b);
-            let q_try = a + b * p_try;
-            // The poppet closes an empty absorber: no oil leaves it.
-            if st.v <= 0.0 && q_try < 0.0 {
-                st.q = 0.0;
-                st.v = 0.0;
-                st.g = gas.precharge_abs_pa();
-            } else {
-                p_new = p_try;
-                st.q = q_try;
-                let v_new = (st.v + h * q_try).max(0.0);
-                st.g = if v_new > 0.0 {
-                    st.g + k_g * (v_new - st.v)
+        let p_new = match &hp.absorber {
+            None => rhs / diag,
+            Some(gas) => {
+                // The inlet, (I + h·R + h²·k_g)·q' = I·q − h·p_gas + h·p' with the gas's
+                // stiffness k_g = n·p_g/V_g, taken times V_g; with the node's
+                // diag·p' = rhs − h·q' it gives p' in one division, and q' from the node
+                // without another: the divisions a substep waits on are the pressure's alone.
+                let gas_vol = (gas.shell_volume_m3 - st.v).max(1e-3 * gas.shell_volume_m3);
+                let inlet = hp.inlet_inertance_kg_m4 + h * hp.inlet_resistance_pa_s_m3;
+                let den = inlet * gas_vol + h * h * gas.exponent * st.g;
+                let drive =
+                    (hp.inlet_inertance_kg_m4 * st.q - h * (st.g - ATMOSPHERE_PA)) * gas_vol;
+                let p_try = (rhs * den - h * drive) / (diag * den + h * h * gas_vol);
+                let q_try = (rhs - diag * p_try) * step.per_h;
+                // The poppet closes an empty absorber: no oil leaves it.
+                if st.v <= 0.0 && q_try < 0.0 {
+                    st.q = 0.0;
+                    st.v = 0.0;
+                    st.g = gas.precharge_abs_pa();
+                    rhs / diag
                 } else {
-                    gas.precharge_abs_pa()
-                };
-                st.v = v_new;
+                    st.q = q_try;
+                    let v_new = (st.v + h * q_try).max(0.0);
+                    st.g = if v_new > 0.0 {
+                        st.g + gas.exponent * st.g / gas_vol * (v_new - st.v)
+                    } else {
+                        gas.precharge_abs_pa()
+                    };
+                    st.v = v_new;
+                    p_try
+                }
             }
-        }
+        };
         // The check valve from the fill feeds the port below the fill level.
         let p_start = st.p;
         st.p = p_new.max(floor);
-        st.s = lag.next(st.s, p_start, st.p);
+        st.s = step.lag.next(st.s, p_start, st.p);
     }
 }
 

@@ -1,26 +1,40 @@
-//! The pressure transducer's first-order lag over a substep (the hydraulic relation's
-//! τ·dp_s/dt = p − p_s, solved exactly for p moving linearly from p₀ to p₁ over the
-//! substep h: p_s ← p_s + a·(p₀ − p_s) + b·(p₁ − p₀), a = 1 − e^(−h/τ), b = 1 − τ·a/h —
-//! the ramp's own response, so the reading trails a ramp of rate r by r·τ whatever h):
-//! its step factors, computed once for each substep length met.
+//! A log interval's integration in the hydraulic relation: the substeps it is cut into,
+//! their length h, and the pressure transducer's first-order lag over each (τ·dp_s/dt =
+//! p − p_s, solved exactly for p moving linearly from p₀ to p₁ over the substep:
+//! p_s ← p_s + a·(p₀ − p_s) + b·(p₁ − p₀), a = 1 − e^(−h/τ), b = 1 − τ·a/h — the ramp's
+//! own response, so the reading trails a ramp of rate r by r·τ whatever h), computed once
+//! for each interval met.
 
-/// The transducer's step factors (a, b) of the last few substep lengths h met, each
-/// computed once. A logged time column's intervals differ in their last bits from row to
-/// row (times written to a tenth of a millisecond and read back take a dozen or so
-/// distinct differences, changing on most rows), so one remembered length would miss on
-/// most rows; a handful, matched exactly, hits on nearly all, and every factor is the one
-/// computed for its own length.
+/// The integration of the last few log intervals met, each computed once. A logged time
+/// column's intervals differ in their last bits from row to row (times written to a tenth
+/// of a millisecond and read back take a dozen or so distinct differences, changing on most
+/// rows), so one remembered interval would miss on most rows; a handful, matched exactly,
+/// hits on nearly all, and every interval's values are those computed for it.
 pub struct LagFactors {
     /// Time constant τ. [s]
     tau: f64,
-    /// Lengths h [s] and their factors (a, b) [1]; unused slots hold NaN, which matches
-    /// nothing.
-    seen: [(f64, Step); LagFactors::KEPT],
-    /// The slot the next new length takes.
+    /// The substeps an interval [s] is cut into.
+    cut: fn(f64) -> usize,
+    /// Intervals [s] and their integration; unused slots hold NaN, which matches nothing.
+    seen: [(f64, Interval); LagFactors::KEPT],
+    /// The slot the next new interval takes.
     next: usize,
 }
 
-/// The factors of one substep length. [1]
+/// One log interval's integration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interval {
+    /// Substeps the interval is cut into. [1]
+    pub steps: usize,
+    /// Their length h. [s]
+    pub h: f64,
+    /// 1/h, known before a substep starts. [1/s]
+    pub per_h: f64,
+    /// The transducer's factors over a substep.
+    pub lag: Step,
+}
+
+/// The transducer's factors over one substep length. [1]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Step {
     /// Weight of the reading's distance from the pressure at the substep's start,
@@ -40,25 +54,35 @@ impl Step {
 }
 
 impl LagFactors {
-    /// Lengths kept.
+    /// Intervals kept.
     const KEPT: usize = 16;
 
-    /// The factors of time constant `tau` [s], none computed yet.
-    pub fn new(tau: f64) -> LagFactors {
+    /// The integration of time constant `tau` [s] with intervals cut by `cut`, none
+    /// computed yet.
+    pub fn new(tau: f64, cut: fn(f64) -> usize) -> LagFactors {
+        let unused = Interval {
+            steps: 1,
+            h: f64::NAN,
+            per_h: f64::NAN,
+            lag: Step { a: 1.0, b: 1.0 },
+        };
         LagFactors {
             tau,
-            seen: [(f64::NAN, Step { a: 1.0, b: 1.0 }); LagFactors::KEPT],
+            cut,
+            seen: [(f64::NAN, unused); LagFactors::KEPT],
             next: 0,
         }
     }
 
-    /// The factors of substep length `h`.
+    /// The integration of log interval `dt` [s].
     #[inline]
-    pub fn at(&mut self, h: f64) -> Step {
-        if let Some((_, f)) = self.seen.iter().find(|(seen, _)| *seen == h) {
+    pub fn at(&mut self, dt: f64) -> Interval {
+        if let Some((_, f)) = self.seen.iter().find(|(seen, _)| *seen == dt) {
             return *f;
         }
-        let f = if self.tau > 0.0 && h > 0.0 {
+        let steps = (self.cut)(dt).max(1);
+        let h = dt / steps as f64;
+        let lag = if self.tau > 0.0 && h > 0.0 {
             // −expm1 keeps a's digits where h ≪ τ; b = 1 − τ·a/h ≈ h/(2τ) there.
             let a = -(-h / self.tau).exp_m1();
             Step {
@@ -68,7 +92,13 @@ impl LagFactors {
         } else {
             Step { a: 1.0, b: 1.0 }
         };
-        self.seen[self.next] = (h, f);
+        let f = Interval {
+            steps,
+            h,
+            per_h: 1.0 / h,
+            lag,
+        };
+        self.seen[self.next] = (dt, f);
         self.next = (self.next + 1) % LagFactors::KEPT;
         f
     }
@@ -86,25 +116,25 @@ mod tests {
         // pressure.
         let tau = 2e-3;
         let lengths: Vec<f64> = (0..40).map(|k| 0.5e-3 * (1.0 + 1e-13 * k as f64)).collect();
-        let mut factors = LagFactors::new(tau);
+        let mut factors = LagFactors::new(tau, |_| 1);
         for &h in lengths.iter().chain(&lengths).chain(lengths.iter().rev()) {
             let a = -(-h / tau).exp_m1();
             let expected = Step {
                 a,
                 b: 1.0 - tau * a / h,
             };
-            assert_eq!(factors.at(h), expected, "{h:e}");
-            assert_eq!(factors.at(h), expected, "{h:e} again");
+            assert_eq!(factors.at(h).lag, expected, "{h:e}");
+            assert_eq!(factors.at(h).lag, expected, "{h:e} again");
         }
         // Against the exponential's series: for x = h/τ ≪ 1, a = x − x²/2 + x³/6 − … and
         // b = x/2 − x²/6 + x³/24 − …, each within its next term (alternating series).
-        let mut fresh = LagFactors::new(1.0);
+        let mut fresh = LagFactors::new(1.0, |_| 1);
         let x = 1e-3;
-        let step = fresh.at(x);
+        let step = fresh.at(x).lag;
         assert!((step.a - (x - x * x / 2.0 + x * x * x / 6.0)).abs() < x.powi(4) / 24.0 + 1e-18);
         assert!((step.b - (x / 2.0 - x * x / 6.0)).abs() < x.powi(3) / 24.0 + 1e-15);
-        let mut none = LagFactors::new(0.0);
-        assert_eq!(none.at(0.5e-3).next(3.0, 5.0, 7.0), 7.0);
+        let mut none = LagFactors::new(0.0, |_| 1);
+        assert_eq!(none.at(0.5e-3).lag.next(3.0, 5.0, 7.0), 7.0);
     }
 
     #[test]
@@ -113,12 +143,12 @@ mod tests {
         // Stepped with lengths from 0.05 to 2 τ in turn, the reading matches the solution
         // at every step to rounding.
         let (tau, p0, r) = (4e-3, 2e6, 3e8);
-        let mut lags = LagFactors::new(tau);
+        let mut lags = LagFactors::new(tau, |_| 1);
         let (mut t, mut s) = (0.0, p0);
         for k in 0..400 {
             let h = tau * [0.05, 0.125, 0.5, 1.0, 2.0][k % 5];
             let (pa, pb) = (p0 + r * t, p0 + r * (t + h));
-            s = lags.at(h).next(s, pa, pb);
+            s = lags.at(h).lag.next(s, pa, pb);
             t += h;
             let exact = p0 + r * t - r * tau * (1.0 - (-t / tau).exp());
             assert!(
@@ -126,5 +156,21 @@ mod tests {
                 "t {t}: {s} against {exact}"
             );
         }
+    }
+
+    #[test]
+    fn an_interval_is_cut_as_its_rule_says_and_remembered_as_first_computed() {
+        // Cut into substeps of at most 1 ms: 2.5 ms into 3 of 5/6 ms, 1 ms into 1, and a
+        // zero-substep rule still takes one; each read again is the same, bit for bit.
+        let mut cut = LagFactors::new(2e-3, |dt| (dt / 1e-3).ceil() as usize);
+        for (dt, steps) in [(2.5e-3, 3), (1e-3, 1), (0.4e-3, 1), (2.5e-3, 3)] {
+            let i = cut.at(dt);
+            assert_eq!(i.steps, steps, "{dt}");
+            assert!((i.h * steps as f64 - dt).abs() < 1e-18, "{dt}: h {}", i.h);
+            assert!((i.h * i.per_h - 1.0).abs() < 1e-15, "{dt}");
+            assert_eq!(cut.at(dt), i);
+        }
+        let mut none = LagFactors::new(2e-3, |_| 0);
+        assert_eq!(none.at(1e-3).steps, 1);
     }
 }
