@@ -30,7 +30,7 @@
 //! compliance against the inlet resistance is a time constant of tens of microseconds,
 //! which an explicit rule could only follow with microsecond steps. The transducer is
 //! stepped exactly for the pressure moving linearly over the substep
-//! ([`crate::diagnose::lag_factors`]), so its reading trails a ramp by the ramp's rate
+//! ([`crate::diagnose::intervals`]), so its reading trails a ramp by the ramp's rate
 //! times τ, not by half a substep less.
 //!
 //! Window starts (multiple shooting): the transducer's state and the pressure's slope from a
@@ -40,7 +40,7 @@
 //! filling at the slope.
 
 use crate::diagnose::facts::{rows_spanning, LogFacts, LowSide};
-use crate::diagnose::lag_factors::{Interval, LagFactors};
+use crate::diagnose::intervals::{Interval, Intervals};
 use plant_model::accumulator::{GasCharge, ATMOSPHERE_PA};
 use plant_model::pump::Pump;
 use plant_model::Rig;
@@ -348,7 +348,7 @@ impl Hydraulics {
         // reading of it in true pressure.
         let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
         // Each log interval's substeps and the transducer's factors over them.
-        let mut intervals = LagFactors::new(hp.sensor_lag_s, substeps);
+        let mut intervals = Intervals::new(hp.sensor_lag_s, substeps);
         for k in rows.start..rows.end.saturating_sub(1) {
             let next = k + 1;
             let dt = x.t_s[next] - x.t_s[k];

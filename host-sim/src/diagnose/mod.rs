@@ -48,7 +48,7 @@ pub mod findings;
 pub mod fit_score;
 pub mod hydraulic;
 pub mod hydraulic_relation;
-pub mod lag_factors;
+pub mod intervals;
 pub mod least_squares;
 pub mod lines;
 pub mod loop_response;

@@ -10,13 +10,13 @@
 /// of a millisecond and read back take a dozen or so distinct differences, changing on most
 /// rows), so one remembered interval would miss on most rows; a handful, matched exactly,
 /// hits on nearly all, and every interval's values are those computed for it.
-pub struct LagFactors {
+pub struct Intervals {
     /// Time constant τ. [s]
     tau: f64,
     /// The substeps an interval [s] is cut into.
     cut: fn(f64) -> usize,
     /// Intervals [s] and their integration; unused slots hold NaN, which matches nothing.
-    seen: [(f64, Interval); LagFactors::KEPT],
+    seen: [(f64, Interval); Intervals::KEPT],
     /// The slot the next new interval takes.
     next: usize,
 }
@@ -53,23 +53,23 @@ impl Step {
     }
 }
 
-impl LagFactors {
+impl Intervals {
     /// Intervals kept.
     const KEPT: usize = 16;
 
     /// The integration of time constant `tau` [s] with intervals cut by `cut`, none
     /// computed yet.
-    pub fn new(tau: f64, cut: fn(f64) -> usize) -> LagFactors {
+    pub fn new(tau: f64, cut: fn(f64) -> usize) -> Intervals {
         let unused = Interval {
             steps: 1,
             h: f64::NAN,
             per_h: f64::NAN,
             lag: Step { a: 1.0, b: 1.0 },
         };
-        LagFactors {
+        Intervals {
             tau,
             cut,
-            seen: [(f64::NAN, unused); LagFactors::KEPT],
+            seen: [(f64::NAN, unused); Intervals::KEPT],
             next: 0,
         }
     }
@@ -99,7 +99,7 @@ impl LagFactors {
             lag,
         };
         self.seen[self.next] = (dt, f);
-        self.next = (self.next + 1) % LagFactors::KEPT;
+        self.next = (self.next + 1) % Intervals::KEPT;
         f
     }
 }
@@ -116,7 +116,7 @@ mod tests {
         // pressure.
         let tau = 2e-3;
         let lengths: Vec<f64> = (0..40).map(|k| 0.5e-3 * (1.0 + 1e-13 * k as f64)).collect();
-        let mut factors = LagFactors::new(tau, |_| 1);
+        let mut factors = Intervals::new(tau, |_| 1);
         for &h in lengths.iter().chain(&lengths).chain(lengths.iter().rev()) {
             let a = -(-h / tau).exp_m1();
             let expected = Step {
@@ -128,12 +128,12 @@ mod tests {
         }
         // Against the exponential's series: for x = h/τ ≪ 1, a = x − x²/2 + x³/6 − … and
         // b = x/2 − x²/6 + x³/24 − …, each within its next term (alternating series).
-        let mut fresh = LagFactors::new(1.0, |_| 1);
+        let mut fresh = Intervals::new(1.0, |_| 1);
         let x = 1e-3;
         let step = fresh.at(x).lag;
         assert!((step.a - (x - x * x / 2.0 + x * x * x / 6.0)).abs() < x.powi(4) / 24.0 + 1e-18);
         assert!((step.b - (x / 2.0 - x * x / 6.0)).abs() < x.powi(3) / 24.0 + 1e-15);
-        let mut none = LagFactors::new(0.0, |_| 1);
+        let mut none = Intervals::new(0.0, |_| 1);
         assert_eq!(none.at(0.5e-3).lag.next(3.0, 5.0, 7.0), 7.0);
     }
 
@@ -143,7 +143,7 @@ mod tests {
         // Stepped with lengths from 0.05 to 2 τ in turn, the reading matches the solution
         // at every step to rounding.
         let (tau, p0, r) = (4e-3, 2e6, 3e8);
-        let mut lags = LagFactors::new(tau, |_| 1);
+        let mut lags = Intervals::new(tau, |_| 1);
         let (mut t, mut s) = (0.0, p0);
         for k in 0..400 {
             let h = tau * [0.05, 0.125, 0.5, 1.0, 2.0][k % 5];
@@ -162,7 +162,7 @@ mod tests {
     fn an_interval_is_cut_as_its_rule_says_and_remembered_as_first_computed() {
         // Cut into substeps of at most 1 ms: 2.5 ms into 3 of 5/6 ms, 1 ms into 1, and a
         // zero-substep rule still takes one; each read again is the same, bit for bit.
-        let mut cut = LagFactors::new(2e-3, |dt| (dt / 1e-3).ceil() as usize);
+        let mut cut = Intervals::new(2e-3, |dt| (dt / 1e-3).ceil() as usize);
         for (dt, steps) in [(2.5e-3, 3), (1e-3, 1), (0.4e-3, 1), (2.5e-3, 3)] {
             let i = cut.at(dt);
             assert_eq!(i.steps, steps, "{dt}");
@@ -170,7 +170,7 @@ mod tests {
             assert!((i.h * i.per_h - 1.0).abs() < 1e-15, "{dt}");
             assert_eq!(cut.at(dt), i);
         }
-        let mut none = LagFactors::new(2e-3, |_| 0);
+        let mut none = Intervals::new(2e-3, |_| 0);
         assert_eq!(none.at(1e-3).steps, 1);
     }
 }
