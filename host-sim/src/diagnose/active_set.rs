@@ -18,6 +18,7 @@
 //!
 //! The Jacobian is taken by forward differences in v, its columns in parallel.
 
+use crate::diagnose::effort::Effort;
 use crate::diagnose::param_spec::ParamSpec;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
@@ -49,13 +50,6 @@ pub const AT_BOUND: f64 = 1e-6;
 /// Step inside its range, as a share of the range, at which a held parameter's
 /// optimality is tried. [1]
 const INSIDE_STEP: f64 = 1e-3;
-
-/// Relative reduction of the objective (and of the step) below which the optimiser stops:
-/// on objectives of 10⁴–10⁵ noise units a hundred-thousandth is 0.1–1 unit, below the χ²
-/// thresholds (15–18) the decision compares differences with. Where a fit stops along a
-/// flat valley moves the validation segment's reading, which the decision weighs against
-/// that spread ([`crate::diagnose::validation_spread`]). [1]
-const FTOL: f64 = 1e-5;
 
 /// The search over the free parameters, the held ones fixed at their bounds.
 struct Problem<'a, M: Model> {
@@ -218,13 +212,8 @@ pub struct Minimum {
 
 /// Minimises the sum of squares of `model`'s residuals (and the priors') over `specs`' u
 /// within their hard bounds, from `u0` (inside the bounds), the optimiser allowed
-/// `patience` iterations per free parameter in each search.
-pub fn minimise<M: Model>(
-    model: &M,
-    specs: &[ParamSpec],
-    u0: Vec<f64>,
-    patience: usize,
-) -> Minimum {
+/// `effort`'s iterations per free parameter in each search and stopped at its tolerance.
+pub fn minimise<M: Model>(model: &M, specs: &[ParamSpec], u0: Vec<f64>, effort: Effort) -> Minimum {
     let n = specs.len();
     let mut u = u0;
     // A parameter pinned to one value (bounds that meet) is held from the start, and for
@@ -239,7 +228,7 @@ pub fn minimise<M: Model>(
         let reached = if free.is_empty() {
             Vec::new()
         } else {
-            let (found, spent) = search(model, specs, &mut u, free, &may_hold, patience);
+            let (found, spent) = search(model, specs, &mut u, free, &may_hold, effort);
             evaluations += spent;
             found
         };
@@ -293,7 +282,7 @@ fn search<M: Model>(
     u: &mut [f64],
     free: Vec<usize>,
     may_hold: &[bool],
-    patience: usize,
+    effort: Effort,
 ) -> (Vec<usize>, usize) {
     let v0 = DVector::from_iterator(free.len(), free.iter().map(|&k| specs[k].v_of_u(u[k])));
     let problem = Problem {
@@ -308,9 +297,9 @@ fn search<M: Model>(
         reached: Mutex::new(Vec::new()),
     };
     let (problem, _report) = LevenbergMarquardt::<f64>::new()
-        .with_patience(patience)
-        .with_ftol(FTOL)
-        .with_xtol(FTOL)
+        .with_patience(effort.patience)
+        .with_ftol(effort.tolerance)
+        .with_xtol(effort.tolerance)
         .minimize(problem);
     let v: Vec<f64> = problem.v.iter().copied().collect();
     u.copy_from_slice(&problem.u_at(&v));
@@ -322,8 +311,8 @@ fn search<M: Model>(
 mod tests {
     use super::*;
 
-    /// The fits' patience ([`crate::diagnose::least_squares::PATIENCE`]).
-    const PATIENCE: usize = 10;
+    /// The screening fits' effort.
+    const EFFORT: Effort = Effort::SCREENING;
 
     #[test]
     fn a_parameter_pressed_against_its_bound_rests_on_it_and_the_others_fit_given_it() {
@@ -339,7 +328,7 @@ mod tests {
             ParamSpec::linear("slope", 0.5, 1.0, 0.0, 1.0),
             ParamSpec::linear("intercept", 0.0, 1.0, -5.0, 5.0),
         ];
-        let m = minimise(&model, &specs, vec![0.0, 0.0], PATIENCE);
+        let m = minimise(&model, &specs, vec![0.0, 0.0], EFFORT);
         let mean_x = x.iter().sum::<f64>() / x.len() as f64;
         assert_eq!(m.u[0], specs[0].u_bounds.1, "the slope rests on its bound");
         assert!(
@@ -362,7 +351,7 @@ mod tests {
             ParamSpec::linear("b", 0.0, 1.0, -5.0, 5.0),
         ];
         let start = specs[0].u_bounds.1 - 0.1 * AT_BOUND;
-        let m = minimise(&model, &specs, vec![start, 0.0], PATIENCE);
+        let m = minimise(&model, &specs, vec![start, 0.0], EFFORT);
         let (a, b) = (specs[0].value(m.u[0]), specs[1].value(m.u[1]));
         assert!(
             (a - 0.2).abs() < 1e-6 && (b - 0.8).abs() < 1e-6,

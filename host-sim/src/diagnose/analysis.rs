@@ -14,7 +14,7 @@
 //!    order spectra of the baseline) and the contract's result.
 
 use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
-use super::calibration::{calibrate, test_release_at_nominal, Release};
+use super::calibration::{calibrate, polished, test_release_at_nominal, Release};
 use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
 use super::contributions::contributions;
 use super::cylinder::{self};
@@ -92,7 +92,7 @@ fn calibrate_all(r: &Relations<'_>, progress: &dyn Progress) -> Calibrations {
     let ((hydraulic, mechanical), (electrical, cylinder)) = rayon::join(
         || {
             rayon::join(
-                || done(calibrate(&r.patient(&r.hydraulic), &r.h_id), "calibration"),
+                || done(calibrate(&r.screened(&r.hydraulic), &r.h_id), "calibration"),
                 || done(calibrate(&r.patient(&r.mechanical), &r.m_id), "calibration"),
             )
         },
@@ -150,7 +150,7 @@ fn test_relations(
             rayon::join(
                 || {
                     let t = test_relation(
-                        &r.patient(&r.hydraulic),
+                        &r.screened(&r.hydraulic),
                         h,
                         &r.h_id,
                         &r.h_val,
@@ -240,7 +240,7 @@ pub fn analyse_reporting(
     // The fits' vectors reused from the heap, until the predictions.
     let fit_stage = crate::memory::FitStage::begin();
     // 2. Calibration.
-    let cal = calibrate_all(&rel, progress);
+    let mut cal = calibrate_all(&rel, progress);
     // 3. Lines, read with the calibrated shaft.
     let mv = &cal.mechanical.fitted.values;
     let shaft = ShaftConstants {
@@ -278,6 +278,10 @@ pub fn analyse_reporting(
     let displacement = displacement::from_shaft(&cal.mechanical, cal.electrical.as_ref(), rig)
         .filter(|_| !facts.piston_moves);
     let (named, hydraulic_values) = select(&rel, &mut tested, rig, displacement);
+    // The baseline the report predicts with, driven on from the screening's calibration.
+    if let Some(effort) = rel.reported_effort() {
+        cal.hydraulic = polished(&rel.hydraulic, &rel.h_id, &cal.hydraulic, effort);
+    }
     // The line bases served the fits; the predictions do not read them.
     rel.mechanical.forget_bases();
     drop(fit_stage);

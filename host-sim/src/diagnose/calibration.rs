@@ -33,7 +33,7 @@
 
 use crate::diagnose::facts::{rows_spanning, LogFacts};
 use crate::diagnose::least_squares::{
-    fit_with_patience, variance_per_independent_sample, Fitted, ParamSpec, PATIENCE,
+    fit_with, variance_per_independent_sample, Effort, Fitted, ParamSpec,
 };
 use std::ops::Range;
 
@@ -122,9 +122,9 @@ pub trait Relation: Sync {
     fn grid_basins(&self, _release: Release) -> usize {
         0
     }
-    /// The optimiser's patience on this relation (iterations per parameter).
-    fn patience(&self) -> usize {
-        PATIENCE
+    /// How far the optimiser is driven on this relation.
+    fn effort(&self) -> Effort {
+        Effort::SCREENING
     }
     /// The facts of the log the relation reads.
     fn facts(&self) -> &LogFacts;
@@ -145,12 +145,12 @@ pub fn scaled(nominal: f64, factors: &[f64]) -> Vec<f64> {
     factors.iter().map(|f| nominal * f).collect()
 }
 
-/// A relation fitted with another optimiser patience than [`PATIENCE`].
+/// A relation fitted with another effort than [`Effort::SCREENING`].
 pub struct Patient<'r, R> {
     /// The relation.
     pub relation: &'r R,
-    /// Iterations per parameter.
-    pub patience: usize,
+    /// How far its fits are driven.
+    pub effort: Effort,
 }
 
 impl<R: Relation> Relation for Patient<'_, R> {
@@ -163,8 +163,8 @@ impl<R: Relation> Relation for Patient<'_, R> {
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
         self.relation.released(release)
     }
-    fn patience(&self) -> usize {
-        self.patience
+    fn effort(&self) -> Effort {
+        self.effort
     }
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
@@ -204,8 +204,8 @@ impl<R: Relation> Relation for Pinned<'_, R> {
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
         self.relation.released(release)
     }
-    fn patience(&self) -> usize {
-        self.relation.patience()
+    fn effort(&self) -> Effort {
+        self.relation.effort()
     }
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
@@ -246,8 +246,8 @@ impl<R: Relation> Relation for Freed<'_, R> {
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
         self.relation.released(release)
     }
-    fn patience(&self) -> usize {
-        self.relation.patience()
+    fn effort(&self) -> Effort {
+        self.relation.effort()
     }
     fn facts(&self) -> &LogFacts {
         self.relation.facts()
@@ -292,7 +292,7 @@ pub fn fit_relation<R: Relation>(
         r.iter_mut().for_each(|x| *x *= w);
         r
     };
-    fit_with_patience(&model, &specs, relation.patience())
+    fit_with(&model, &specs, relation.effort())
 }
 
 /// Calibrates `relation` within its bands over `rows`: weighed first by the nominal
@@ -306,6 +306,33 @@ pub fn calibrate<R: Relation>(relation: &R, rows: &[Range<usize>]) -> Calibratio
     let scale = variance_per_independent_sample(&relation.residuals(&first.values, rows), bin);
     let fitted = reweighed(relation, rows, Release::Nothing, &first, scale0, scale);
     Calibration { fitted, scale }
+}
+
+/// `c`, a fit of `relation` within its bands over `rows`, driven on with `effort` from
+/// where it stopped, at its weighing: the better of the two.
+pub fn polished<R: Relation>(
+    relation: &R,
+    rows: &[Range<usize>],
+    c: &Calibration,
+    effort: Effort,
+) -> Calibration {
+    let further = Patient { relation, effort };
+    let f = fit_relation(
+        &further,
+        rows,
+        Release::Nothing,
+        c.scale,
+        Some(&c.fitted.values),
+    );
+    let objective = |f: &Fitted| f.data_sse + f.prior_sse;
+    if objective(&f) < objective(&c.fitted) {
+        Calibration {
+            fitted: f,
+            scale: c.scale,
+        }
+    } else {
+        c.clone()
+    }
 }
 
 /// `f`, fitted with the residuals weighed by 1/`from`, as weighed by 1/`to`. Without

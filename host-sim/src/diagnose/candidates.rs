@@ -158,6 +158,45 @@ fn released_effect(release: Release, v: &[f64]) -> (&'static [usize], &'static s
     }
 }
 
+/// The catalogue's parameters of `release` at the relation's `values` (the main parameter's
+/// value first).
+pub fn parameters_at(release: Release, v: &[f64], rig: &Rig) -> Vec<(&'static str, f64)> {
+    let (all, _, _) = released_effect(release, v);
+    let value = v[all[0]];
+    match release {
+        Release::Leakage => vec![("coefficient_m3_s_pa", value - nominal_leakage(rig))],
+        Release::BulkModulus => {
+            // Only V/β is seen: the bulk modulus the rig file's volume would need.
+            let volume = v[hyd::VOLUME] / rig.cylinder.chamber_a_volume_m3;
+            vec![("effective_bulk_modulus_pa", value / volume)]
+        }
+        Release::Precharge => vec![("precharge_pa", value)],
+        Release::SensorLag => vec![("time_constant_s", value)],
+        Release::ShaftFriction => vec![("coulomb_nm", value), ("static_nm", value)],
+        Release::DeadTime => vec![("dead_time_s", value)],
+        Release::CylinderFriction => {
+            // Both levels beyond the rig file's; the plant raises a breakaway below the
+            // Coulomb level to it.
+            let c = &rig.cylinder;
+            let coulomb = (value - c.coulomb_friction_n).max(0.0);
+            let static_n = (cylinder::breakaway_level(v) - c.static_friction_n).max(coulomb);
+            vec![("coulomb_n", coulomb), ("static_n", static_n)]
+        }
+        Release::Nothing => Vec::new(),
+    }
+}
+
+/// `t`, a relation's test, read again at `fit`: the same relation driven further than the
+/// fit it was tested with (the extended model the report predicts with). The parameters,
+/// the extension and the fit move; the test's verdict and evidence stay as they were.
+pub fn reread(t: &mut Tested, fit: &Calibration, rig: &Rig) {
+    let v = &fit.fitted.values;
+    let (_, _, extension) = released_effect(t.release, v);
+    t.parameters = parameters_at(t.release, v, rig);
+    t.extension = extension;
+    t.fit = Some(fit.clone());
+}
+
 /// Fraction of a released parameter's search range (in its search coordinate) from its
 /// top within which its fit counts as run to the edge. [1]
 pub const SEARCH_EDGE: f64 = 0.02;
@@ -196,28 +235,7 @@ pub fn from_release<R: Relation>(
         Some((lo, hi)) => test.fitted.u[i] > hi || test.fitted.u[i] < lo,
         None => false,
     });
-    let value = specs[indices[0]].value(test.fitted.u[indices[0]]);
-    let parameters = match test.release {
-        Release::Leakage => vec![("coefficient_m3_s_pa", value - nominal_leakage(rig))],
-        Release::BulkModulus => {
-            // Only V/β is seen: the bulk modulus the rig file's volume would need.
-            let volume = v[hyd::VOLUME] / rig.cylinder.chamber_a_volume_m3;
-            vec![("effective_bulk_modulus_pa", value / volume)]
-        }
-        Release::Precharge => vec![("precharge_pa", value)],
-        Release::SensorLag => vec![("time_constant_s", value)],
-        Release::ShaftFriction => vec![("coulomb_nm", value), ("static_nm", value)],
-        Release::DeadTime => vec![("dead_time_s", value)],
-        Release::CylinderFriction => {
-            // Both levels beyond the rig file's; the plant raises a breakaway below the
-            // Coulomb level to it.
-            let c = &rig.cylinder;
-            let coulomb = (value - c.coulomb_friction_n).max(0.0);
-            let static_n = (cylinder::breakaway_level(v) - c.static_friction_n).max(coulomb);
-            vec![("coulomb_n", coulomb), ("static_n", static_n)]
-        }
-        Release::Nothing => Vec::new(),
-    };
+    let parameters = parameters_at(test.release, v, rig);
     let validation_gain = (!validation.is_empty()).then(|| {
         weighed_sse(relation, &test.baseline.values, validation, test.scale)
             - weighed_sse(relation, &test.fitted.values, validation, test.scale)

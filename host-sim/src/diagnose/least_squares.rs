@@ -15,6 +15,7 @@
 
 pub use crate::diagnose::active_set::Model;
 use crate::diagnose::active_set::{minimise, Minimum};
+pub use crate::diagnose::effort::Effort;
 pub use crate::diagnose::param_spec::ParamSpec;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -112,24 +113,13 @@ pub fn variance_per_independent_sample(r: &[f64], bin: usize) -> f64 {
     (ms * bin as f64).max(f64::MIN_POSITIVE) * tau.max(1.0)
 }
 
-/// Iterations the optimiser may spend per parameter (its `patience`). The hydraulic
-/// relation's tolerance bands leave flat curved valleys (transducer gain against
-/// displacement and volume) along which the optimiser creeps by hundredths of a noise unit
-/// per iteration long after the decision's differences (χ² thresholds of 15–18 units) are
-/// settled: ten per parameter bound that creep and leave the decisions as they were.
-pub const PATIENCE: usize = 10;
-
-/// The patience of a fit whose parameters are used, not only compared (a feed-forward
-/// learned from them): the creep along the valleys is followed to its end.
-pub const THOROUGH_PATIENCE: usize = 25;
-
 /// Fits `specs` to `model` from their starts.
 pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
-    fit_with_patience(model, specs, PATIENCE)
+    fit_with(model, specs, Effort::SCREENING)
 }
 
-/// [`fit`] with the optimiser's `patience` (iterations per parameter).
-pub fn fit_with_patience<M: Model>(model: &M, specs: &[ParamSpec], patience: usize) -> Fitted {
+/// [`fit`] driven as far as `effort` says.
+pub fn fit_with<M: Model>(model: &M, specs: &[ParamSpec], effort: Effort) -> Fitted {
     // A start on a bound would freeze the search there (the sine transform is flat at its
     // ends): every start at least 1 % of the range inside.
     let u0: Vec<f64> = specs
@@ -140,7 +130,7 @@ pub fn fit_with_patience<M: Model>(model: &M, specs: &[ParamSpec], patience: usi
             s.start.clamp(lo + margin, hi - margin)
         })
         .collect();
-    let Minimum { u, evaluations } = minimise(model, specs, u0, patience);
+    let Minimum { u, evaluations } = minimise(model, specs, u0, effort);
     let values: Vec<f64> = specs.iter().zip(&u).map(|(s, u)| s.value(*u)).collect();
     let data = model.residuals(&values);
     let data_sse = data
@@ -351,5 +341,46 @@ mod tests {
             "{}",
             f.values[0]
         );
+    }
+
+    /// Rosenbrock's valley, y = x², under a floor of 10⁴ noise units (fixed rows of unit
+    /// size, as a relation's residuals are): the objective falls along the valley by a few
+    /// units in all, a fraction of a unit per iteration near its end. Minimum at (1, 1).
+    fn valley(v: &[f64]) -> Vec<f64> {
+        let mut r: Vec<f64> = (0..10_000)
+            .map(|k| if k % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        r.push(2.0 * (v[1] - v[0] * v[0]));
+        r.push(1.0 - v[0]);
+        r
+    }
+
+    #[test]
+    fn a_screened_fit_driven_on_reaches_the_valley_floor_it_stopped_short_of() {
+        let specs = [
+            ParamSpec::linear("x", -1.2, 1.0, -3.0, 3.0),
+            ParamSpec::linear("y", 1.0, 1.0, -3.0, 3.0),
+        ];
+        let floor = 10_000.0;
+        let screened = fit_with(&valley, &specs, Effort::SCREENING);
+        let from: Vec<ParamSpec> = specs
+            .iter()
+            .zip(&screened.values)
+            .map(|(s, v)| s.clone().starting_at(*v))
+            .collect();
+        let reported = fit_with(&valley, &from, Effort::REPORTED);
+        assert!(reported.data_sse <= screened.data_sse);
+        // The screening stops where an iteration gains under 3·10⁻⁵ of the objective (0.3
+        // of a unit): short of the floor along the valley.
+        assert!(screened.data_sse - floor < 0.3, "{}", screened.data_sse);
+        assert!(
+            (screened.values[1] - 1.0).abs() > 0.01,
+            "{:?}",
+            screened.values
+        );
+        // Driven on, it reaches the analytic minimum.
+        for v in &reported.values {
+            assert!((v - 1.0).abs() < 1e-3, "{:?}", reported.values);
+        }
     }
 }

@@ -40,6 +40,7 @@ pub mod dead_time;
 pub mod decision;
 pub mod diagnosis;
 pub mod displacement;
+pub mod effort;
 pub mod electrical;
 pub mod emf_law;
 mod error;

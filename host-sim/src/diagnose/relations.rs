@@ -7,10 +7,10 @@
 
 use super::calibration::{thinned, Calibration, Patient, MAX_FIT_S};
 use super::cylinder::CylinderRelation;
+use super::effort::Effort;
 use super::electrical::ElectricalRelation;
 use super::facts::{rows_spanning, LogFacts};
 use super::hydraulic_relation::{HydraulicRelation, HYDRAULIC_WINDOW_S};
-use super::least_squares::{PATIENCE, THOROUGH_PATIENCE};
 use super::mechanical::ShaftMotion;
 use super::mechanical_relation::MechanicalRelation;
 use crate::bench_log::BenchLog;
@@ -56,8 +56,11 @@ pub(super) struct Relations<'a> {
     pub(super) electrical: Option<ElectricalRelation<'a>>,
     pub(super) cylinder: Option<CylinderRelation<'a>>,
     pub(super) orders: Vec<u32>,
-    /// The optimiser's patience on every relation.
-    pub(super) patience: usize,
+    /// How far the fits whose values are used are driven: every relation's but the
+    /// hydraulic one's screening.
+    pub(super) effort: Effort,
+    /// How far the hydraulic relation's calibrations and tests are driven.
+    pub(super) screening: Effort,
 }
 
 impl<'a> Relations<'a> {
@@ -86,18 +89,37 @@ impl<'a> Relations<'a> {
             electrical: ElectricalRelation::of(log, facts, rig),
             cylinder: CylinderRelation::of(log, facts, rig),
             orders,
-            patience: match precision {
-                Precision::Diagnosis => PATIENCE,
-                Precision::Learning => THOROUGH_PATIENCE,
+            effort: match precision {
+                Precision::Diagnosis => Effort::REPORTED,
+                Precision::Learning => Effort::THOROUGH,
+            },
+            screening: match precision {
+                Precision::Diagnosis => Effort::SCREENING,
+                Precision::Learning => Effort::THOROUGH,
             },
         }
     }
 
-    /// `relation` fitted with the precision's patience.
+    /// How far the hydraulic fits the report predicts with are driven on from the
+    /// screening's: `None` where the screening drives them that far already.
+    pub(super) fn reported_effort(&self) -> Option<Effort> {
+        (self.screening != self.effort).then_some(self.effort)
+    }
+
+    /// The hydraulic relation, whose flat valleys the screening does not follow to their
+    /// end ([`super::effort`]), fitted with the precision's screening effort.
+    pub(super) fn screened<'r, R>(&self, relation: &'r R) -> Patient<'r, R> {
+        Patient {
+            relation,
+            effort: self.screening,
+        }
+    }
+
+    /// `relation` fitted with the precision's effort.
     pub(super) fn patient<'r, R>(&self, relation: &'r R) -> Patient<'r, R> {
         Patient {
             relation,
-            patience: self.patience,
+            effort: self.effort,
         }
     }
 }

@@ -22,8 +22,10 @@
 //! log cannot tell them from is marked beside them ([`super::ambiguity`]).
 
 use super::ambiguity::mark;
-use super::calibration::{calibrate, test_release, Calibration, Freed, Relation, Release};
-use super::candidates::{from_release, Extension, Tested};
+use super::calibration::{
+    calibrate, polished, test_release, Calibration, Freed, Relation, Release,
+};
+use super::candidates::{from_release, reread, Extension, Tested};
 use super::decision::{apply_vetoes, threshold, why_not};
 use super::displacement::{read_volumes_at, Displacement};
 use super::relations::Relations;
@@ -96,7 +98,7 @@ fn forward_hydraulic(
     tested: &mut [Tested],
     rig: &Rig,
 ) -> (Vec<usize>, Option<Vec<f64>>) {
-    let relation = rel.patient(&rel.hydraulic);
+    let relation = rel.screened(&rel.hydraulic);
     let first_round: Vec<Tested> = tested.to_vec();
     let mut pool: Vec<usize> = (0..tested.len())
         .filter(|&i| family(&tested[i]) == Family::Hydraulic)
@@ -126,7 +128,8 @@ fn forward_hydraulic(
         }
     }
     if named.len() < 2 {
-        return (named.clone(), base.map(|b| b.fitted.values));
+        let values = base.map(|b| reported(rel, tested, &named, b, rig));
+        return (named, values);
     }
     // Backward: each named effect against the model extended by all the others.
     let mut kept = named.clone();
@@ -161,12 +164,36 @@ fn forward_hydraulic(
         relation: &relation,
         freed: kept.iter().map(|&i| tested[i].release).collect(),
     };
-    let values = match kept.as_slice() {
+    let extended = match kept.as_slice() {
         [] => None,
-        [one] => tested[*one].fit.as_ref().map(|f| f.fitted.values.clone()),
-        _ => Some(calibrate(&freed, &rel.h_id).fitted.values),
+        [one] => tested[*one].fit.clone(),
+        _ => Some(calibrate(&freed, &rel.h_id)),
     };
+    let values = extended.map(|c| reported(rel, tested, &kept, c, rig));
     (kept, values)
+}
+
+/// The hydraulic relation's values with the `named` releases freed, from their fit `c`:
+/// driven on to the report's effort, and each named entry of `tested` read again there.
+fn reported(
+    rel: &Relations<'_>,
+    tested: &mut [Tested],
+    named: &[usize],
+    c: Calibration,
+    rig: &Rig,
+) -> Vec<f64> {
+    let Some(effort) = rel.reported_effort() else {
+        return c.fitted.values;
+    };
+    let freed = Freed {
+        relation: &rel.hydraulic,
+        freed: named.iter().map(|&i| tested[i].release).collect(),
+    };
+    let c = polished(&freed, &rel.h_id, &c, effort);
+    for &i in named {
+        reread(&mut tested[i], &c, rig);
+    }
+    c.fitted.values
 }
 
 /// `release` tested on `relation` (the model extended by its freed effects) against
