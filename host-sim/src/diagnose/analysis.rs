@@ -277,10 +277,17 @@ pub fn analyse_reporting(
     // A blocked cylinder's volume balance is read at the displacement the shaft fixes.
     let displacement = displacement::from_shaft(&cal.mechanical, cal.electrical.as_ref(), rig)
         .filter(|_| !facts.piston_moves);
-    let (named, hydraulic_values) = select(&rel, &mut tested, rig, displacement);
-    // The baseline the report predicts with, driven on from the screening's calibration.
-    if let Some(effort) = rel.reported_effort() {
-        cal.hydraulic = polished(&rel.hydraulic, &rel.h_id, &cal.hydraulic, effort);
+    // Beside it, the baseline the report predicts with, driven on from the screening's
+    // calibration.
+    let ((named, hydraulic_values), base) = rayon::join(
+        || select(&rel, &mut tested, rig, displacement),
+        || {
+            rel.reported_effort()
+                .map(|effort| polished(&rel.hydraulic, &rel.h_id, &cal.hydraulic, effort))
+        },
+    );
+    if let Some(base) = base {
+        cal.hydraulic = base;
     }
     // The line bases served the fits; the predictions do not read them.
     rel.mechanical.forget_bases();

@@ -35,6 +35,7 @@ use crate::diagnose::facts::{rows_spanning, LogFacts};
 use crate::diagnose::least_squares::{
     fit_with, variance_per_independent_sample, Effort, Fitted, ParamSpec,
 };
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// Most log time a fit evaluates per model run: longer segments are thinned
@@ -394,8 +395,17 @@ pub fn test_release<R: Relation>(
     let (best, others) = release_starts(relation, release, base, |v| objective_at(v, base.scale));
     let fit_from = |start: &[f64]| fit_relation(relation, rows, release, base.scale, Some(start));
     let objective = |f: &Fitted| f.data_sse + f.prior_sse;
-    let first = others.iter().fold(fit_from(&best), |kept, start| {
-        let f = fit_from(start);
+    // The starts fitted side by side; of equal objectives the first start's fit is kept.
+    let (head, rest) = rayon::join(
+        || fit_from(&best),
+        || {
+            others
+                .par_iter()
+                .map(|start| fit_from(start))
+                .collect::<Vec<_>>()
+        },
+    );
+    let first = rest.into_iter().fold(head, |kept, f| {
         if objective(&f) < objective(&kept) {
             f
         } else {

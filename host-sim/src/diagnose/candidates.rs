@@ -39,6 +39,7 @@ use crate::diagnose::mechanical_relation::mech;
 use crate::diagnose::validation_spread::{validation_spread, VALIDATION_TOLERANCE};
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::Rig;
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// Smallest line amplitudes a healthy rig is granted, per line effect.
@@ -403,7 +404,7 @@ pub fn test_relation<R: Relation>(
     rig: &Rig,
 ) -> Vec<Tested> {
     releases
-        .iter()
+        .par_iter()
         .map(|r| {
             let t = test_release(relation, identification, *r, calibration);
             from_release(relation, &t, identification, validation, rig)

@@ -30,6 +30,7 @@ use super::decision::{apply_vetoes, threshold, why_not};
 use super::displacement::{read_volumes_at, Displacement};
 use super::relations::Relations;
 use plant_model::Rig;
+use rayon::prelude::*;
 
 /// Which residual an effect's test reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -123,8 +124,12 @@ fn forward_hydraulic(
             relation: &relation,
             freed: named.iter().map(|&i| tested[i].release).collect(),
         };
-        for &i in &pool {
-            tested[i] = judged(&freed, base, tested[i].release, rel, rig);
+        let again: Vec<Tested> = pool
+            .par_iter()
+            .map(|&i| judged(&freed, base, tested[i].release, rel, rig))
+            .collect();
+        for (&i, t) in pool.iter().zip(again) {
+            tested[i] = t;
         }
     }
     if named.len() < 2 {
