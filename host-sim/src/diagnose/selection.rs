@@ -136,23 +136,44 @@ fn forward_hydraulic(
         let values = base.map(|b| reported(rel, tested, &named, b, rig));
         return (named, values);
     }
-    // Backward: each named effect against the model extended by all the others.
-    let mut kept = named.clone();
-    for &a in &named {
-        let others: Vec<Release> = kept
-            .iter()
-            .filter(|&&i| i != a)
-            .map(|&i| tested[i].release)
-            .collect();
-        if others.len() == kept.len() {
-            continue;
-        }
+    // Backward: each named effect against the model extended by all the others. The checks
+    // and the extended model's calibration run side by side as though none were dropped; a
+    // check after a drop is run again against the effects still kept.
+    let check = |a: usize, kept: &[usize], tested: &[Tested]| -> Tested {
         let freed = Freed {
             relation: &relation,
-            freed: others,
+            freed: kept
+                .iter()
+                .filter(|&&i| i != a)
+                .map(|&i| tested[i].release)
+                .collect(),
         };
         let with_others = calibrate(&freed, &rel.h_id);
-        let again = judged(&freed, &with_others, tested[a].release, rel, rig);
+        judged(&freed, &with_others, tested[a].release, rel, rig)
+    };
+    let extended_by = |kept: &[usize], tested: &[Tested]| {
+        let freed = Freed {
+            relation: &relation,
+            freed: kept.iter().map(|&i| tested[i].release).collect(),
+        };
+        calibrate(&freed, &rel.h_id)
+    };
+    let (guessed, all_kept) = rayon::join(
+        || {
+            named
+                .par_iter()
+                .map(|&a| check(a, &named, tested))
+                .collect::<Vec<_>>()
+        },
+        || extended_by(&named, tested),
+    );
+    let mut kept = named.clone();
+    for (&a, guess) in named.iter().zip(guessed) {
+        let again = if kept == named {
+            guess
+        } else {
+            check(a, &kept, tested)
+        };
         if why_not(&again).is_none() {
             tested[a] = again;
         } else {
@@ -165,14 +186,11 @@ fn forward_hydraulic(
             ));
         }
     }
-    let freed = Freed {
-        relation: &relation,
-        freed: kept.iter().map(|&i| tested[i].release).collect(),
-    };
     let extended = match kept.as_slice() {
         [] => None,
         [one] => tested[*one].fit.clone(),
-        _ => Some(calibrate(&freed, &rel.h_id)),
+        _ if kept == named => Some(all_kept),
+        _ => Some(extended_by(&kept, tested)),
     };
     let values = extended.map(|c| reported(rel, tested, &kept, c, rig));
     (kept, values)
