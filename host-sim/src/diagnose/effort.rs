@@ -40,6 +40,12 @@ impl Effort {
         tolerance: 1e-5,
     };
 
+    /// The effort a fit stopped at this one is driven on to where its result decides or is
+    /// reported: the reported effort after the screening, `None` for the others.
+    pub fn refined(self) -> Option<Effort> {
+        (self == Effort::SCREENING).then_some(Effort::REPORTED)
+    }
+
     /// A fit whose parameters are used beyond the report (a feed-forward learned from
     /// them): the creep along the valleys followed to its end.
     pub const THOROUGH: Effort = Effort {
