@@ -115,7 +115,7 @@ pub fn variance_per_independent_sample(r: &[f64], bin: usize) -> f64 {
 
 /// Fits `specs` to `model` from their starts.
 pub fn fit<M: Model>(model: &M, specs: &[ParamSpec]) -> Fitted {
-    fit_with(model, specs, Effort::SCREENING)
+    fit_with(model, specs, Effort::REPORTED)
 }
 
 /// [`fit`] driven as far as `effort` says.

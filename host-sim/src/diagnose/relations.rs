@@ -103,7 +103,7 @@ impl<'a> Relations<'a> {
     /// How far the hydraulic fits the report predicts with are driven on from the
     /// screening's: `None` where the screening drives them that far already.
     pub(super) fn reported_effort(&self) -> Option<Effort> {
-        (self.screening != self.effort).then_some(self.effort)
+        self.screening.refined()
     }
 
     /// The hydraulic relation, whose flat valleys the screening does not follow to their
