@@ -462,9 +462,11 @@ pub fn test_release<R: Relation>(
         |fitted: &Fitted, baseline: &Fitted| (objective(baseline) - objective(fitted)).max(0.0);
     // A screened test that comes near the decision's thresholds is decided at the
     // effort the screening leaves out: a baseline stopped short of its optimum would credit
-    // the released parameter with the rest of the valley.
+    // the released parameter with the rest of the valley. One far above them stands as
+    // screened.
+    let near = (REFINE_ABOVE..REFINE_BELOW).contains(&lambda(&fitted, &baseline));
     let (fitted, baseline) = match relation.effort().refined() {
-        Some(effort) if lambda(&fitted, &baseline) > REFINE_ABOVE => {
+        Some(effort) if near => {
             let on = |f, release| driven_on(relation, rows, release, scale, f, effort);
             rayon::join(|| on(fitted, release), || on(baseline, Release::Nothing))
         }
@@ -479,10 +481,18 @@ pub fn test_release<R: Relation>(
     }
 }
 
-/// Λ of a screened test above which both its fits are driven on to the refined effort: half
-/// the least χ² threshold the decision applies (χ²(1) at 10⁻⁴, 15.1), more than twice what
-/// the screening's tolerance leaves on the objectives it is used on (0.3–3 units). [1]
+/// Λ of a screened test from which both its fits are driven on to the refined effort: half
+/// the least χ² threshold the decision applies (χ²(1) at 10⁻⁴, 15.1). The screening's
+/// tolerance bounds what its last iteration gained, not how far the fit stopped short of
+/// the valley's floor: a test below this is not significant however its fits end. [1]
 const REFINE_ABOVE: f64 = 7.5;
+
+/// Λ of a screened test up to which its fits are driven on: twenty times the least χ²
+/// threshold. Where the two fits stop short they stop short alike (the same valleys of
+/// the same bands, from starts a released parameter apart), so what the refinement moves
+/// is a share of Λ, a few per cent above this (`docs/diagnosis.md`, Speed), and a test this
+/// far above every threshold is decided as screened. [1]
+const REFINE_BELOW: f64 = 300.0;
 
 /// Where the released fit of `release` starts: the grid's best point along the released
 /// parameter, the other parameters either as `base` calibrated them or at their own starts
