@@ -254,8 +254,15 @@ pub fn analyse_reporting(
         .iter()
         .partition(|w| w.window.rows.start < facts.split);
     progress.step("testing effects");
-    // 4. Every effect tested.
-    let mut tested = test_relations(&rel, &cal, &facts, rig, progress);
+    // 4. Every effect tested; beside the tests, the baseline the report predicts with,
+    // driven on from the screening's calibration (it depends on nothing they find).
+    let (mut tested, base) = rayon::join(
+        || test_relations(&rel, &cal, &facts, rig, progress),
+        || {
+            rel.reported_effort()
+                .map(|effort| polished(&rel.hydraulic, &rel.h_id, &cal.hydraulic, effort))
+        },
+    );
     let line_tests = test_lines(
         &line_id,
         &line_val,
@@ -277,15 +284,7 @@ pub fn analyse_reporting(
     // A blocked cylinder's volume balance is read at the displacement the shaft fixes.
     let displacement = displacement::from_shaft(&cal.mechanical, cal.electrical.as_ref(), rig)
         .filter(|_| !facts.piston_moves);
-    // Beside it, the baseline the report predicts with, driven on from the screening's
-    // calibration.
-    let ((named, hydraulic_values), base) = rayon::join(
-        || select(&rel, &mut tested, rig, displacement),
-        || {
-            rel.reported_effort()
-                .map(|effort| polished(&rel.hydraulic, &rel.h_id, &cal.hydraulic, effort))
-        },
-    );
+    let (named, hydraulic_values) = select(&rel, &mut tested, rig, displacement);
     if let Some(base) = base {
         cal.hydraulic = base;
     }
