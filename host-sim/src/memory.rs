@@ -8,7 +8,7 @@
 pub const MAPPED_FROM_B: usize = 128 * 1024;
 
 /// The same threshold while the diagnosis fits ([`FitStage`]): above a fit's per-evaluation
-/// residual vector (8 B a row over the 27 000 rows a fit reads at most, 12 s at one row per
+/// residual vector (8 B a row over the 22 300 rows a fit reads at most, 10 s at one row per
 /// 0.45 ms; twice that once the priors' rows are appended), which the optimiser allocates
 /// and frees at every model run: from the heap it is reused, instead of mapped, faulted in
 /// page by page and unmapped (with the other cores' address translations flushed) each

@@ -39,10 +39,10 @@ use rayon::prelude::*;
 use std::ops::Range;
 
 /// Most log time a fit evaluates per model run: longer segments are thinned
-/// ([`thinned`]). Twelve seconds fix every rig parameter the relations carry; more only
-/// narrows error bars already far inside the bands. A span in time, not rows: a fast log
+/// ([`thinned`]). Ten seconds fix every rig parameter the relations carry; more only
+/// narrows error bars already far inside the bands, at a cost that grows with the rows. A span in time, not rows: a fast log
 /// thinned to a row budget would keep a few windows and fit the tolerances to them. [s]
-pub const MAX_FIT_S: f64 = 12.0;
+pub const MAX_FIT_S: f64 = 10.0;
 
 /// Which parameter of a relation an effect releases from its band.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
