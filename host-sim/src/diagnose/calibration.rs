@@ -40,8 +40,9 @@ use std::ops::Range;
 
 /// Most log time a fit evaluates per model run: longer segments are thinned
 /// ([`thinned`]). Ten seconds fix every rig parameter the relations carry; more only
-/// narrows error bars already far inside the bands, at a cost that grows with the rows. A span in time, not rows: a fast log
-/// thinned to a row budget would keep a few windows and fit the tolerances to them. [s]
+/// narrows error bars already far inside the bands, at a cost that grows with the rows.
+/// A span in time, not rows: a fast log thinned to a row budget would keep a few windows
+/// and fit the tolerances to them. [s]
 pub const MAX_FIT_S: f64 = 10.0;
 
 /// Which parameter of a relation an effect releases from its band.
@@ -483,15 +484,15 @@ pub fn test_release<R: Relation>(
 
 /// Λ of a screened test from which both its fits are driven on to the refined effort: half
 /// the least χ² threshold the decision applies (χ²(1) at 10⁻⁴, 15.1). The screening's
-/// tolerance bounds what its last iteration gained, not how far the fit stopped short of
-/// the valley's floor: a test below this is not significant however its fits end. [1]
+/// tolerance bounds what its last iteration gained, not how far a fit stopped short of the
+/// valley's floor. Below this a test stands as screened: what the refinement could add
+/// there is the released fit's shortfall, a missed effect, never a false alarm. [1]
 const REFINE_ABOVE: f64 = 7.5;
 
 /// Λ of a screened test up to which its fits are driven on: twenty times the least χ²
-/// threshold. Where the two fits stop short they stop short alike (the same valleys of
-/// the same bands, from starts a released parameter apart), so what the refinement moves
-/// is a share of Λ, a few per cent above this (`docs/diagnosis.md`, Speed), and a test this
-/// far above every threshold is decided as screened. [1]
+/// threshold. Above it what the refinement moved was measured to be a small share of Λ
+/// (`docs/diagnosis.md`, Speed), far from carrying a test across any threshold, so such a
+/// test is decided as screened, as every test was before the refinement. [1]
 const REFINE_BELOW: f64 = 300.0;
 
 /// Where the released fit of `release` starts: the grid's best point along the released
