@@ -101,6 +101,15 @@ fn forward_hydraulic(
 ) -> (Vec<usize>, Option<Vec<f64>>) {
     let relation = rel.screened(&rel.hydraulic);
     let first_round: Vec<Tested> = tested.to_vec();
+    // The model with the releases of `kept` freed, `but` one.
+    let freed_by = |kept: &[usize], but: Option<usize>, tested: &[Tested]| Freed {
+        relation: &relation,
+        freed: kept
+            .iter()
+            .filter(|&&i| Some(i) != but)
+            .map(|&i| tested[i].release)
+            .collect(),
+    };
     let mut pool: Vec<usize> = (0..tested.len())
         .filter(|&i| family(&tested[i]) == Family::Hydraulic)
         .collect();
@@ -120,10 +129,7 @@ fn forward_hydraulic(
         if pool.is_empty() {
             break;
         }
-        let freed = Freed {
-            relation: &relation,
-            freed: named.iter().map(|&i| tested[i].release).collect(),
-        };
+        let freed = freed_by(&named, None, tested);
         let again: Vec<Tested> = pool
             .par_iter()
             .map(|&i| judged(&freed, base, tested[i].release, rel, rig))
@@ -140,24 +146,12 @@ fn forward_hydraulic(
     // and the extended model's calibration run side by side as though none were dropped; a
     // check after a drop is run again against the effects still kept.
     let check = |a: usize, kept: &[usize], tested: &[Tested]| -> Tested {
-        let freed = Freed {
-            relation: &relation,
-            freed: kept
-                .iter()
-                .filter(|&&i| i != a)
-                .map(|&i| tested[i].release)
-                .collect(),
-        };
+        let freed = freed_by(kept, Some(a), tested);
         let with_others = calibrate(&freed, &rel.h_id);
         judged(&freed, &with_others, tested[a].release, rel, rig)
     };
-    let extended_by = |kept: &[usize], tested: &[Tested]| {
-        let freed = Freed {
-            relation: &relation,
-            freed: kept.iter().map(|&i| tested[i].release).collect(),
-        };
-        calibrate(&freed, &rel.h_id)
-    };
+    let extended_by =
+        |kept: &[usize], tested: &[Tested]| calibrate(&freed_by(kept, None, tested), &rel.h_id);
     let (guessed, all_kept) = rayon::join(
         || {
             named
