@@ -28,15 +28,8 @@ impl Hydraulics {
         st.s = step.lag.next(st.s, p_start, st.p);
     }
 
-    /// The node's pressure after `h` with no oil through the absorber's inlet, from `st`.
-    #[inline]
-    fn closed(&self, st: &State, h: f64, flows: [f64; 4], c_oil: f64) -> f64 {
-        let (rhs, diag) = self.node(st, h, flows, c_oil);
-        rhs / diag
-    }
-
     /// The node's balance over `h` from `st`, diag·p' = rhs − h·q' (q' the absorber's
-    /// inflow).
+    /// inflow; with it shut, p' = rhs/diag).
     #[inline]
     fn node(&self, st: &State, h: f64, flows: [f64; 4], c_oil: f64) -> (f64, f64) {
         let [q_in, p_low, p_case, _] = flows;
@@ -46,10 +39,17 @@ impl Hydraulics {
         (rhs, c_oil + h * g)
     }
 
+    /// The node's pressure after `h` with the absorber shut, from `st`.
+    #[inline]
+    fn closed(&self, st: &State, h: f64, flows: [f64; 4], c_oil: f64) -> f64 {
+        let (rhs, diag) = self.node(st, h, flows, c_oil);
+        rhs / diag
+    }
+
     /// The node and the absorber over `h` (`per_h` its reciprocal) from `st`, the poppet's
     /// opening and closing located inside the step: an empty absorber opens where the
-    /// closed node's pressure reaches the gas's, a filled one closes where its oil runs
-    /// out; the step is solved up to there and on from there.
+    /// shut node's pressure reaches the gas's, a filled one closes where its oil runs out;
+    /// the step is solved up to there and on from there.
     #[inline]
     fn with_absorber(
         &self,
@@ -60,46 +60,48 @@ impl Hydraulics {
         flows: [f64; 4],
         c_oil: f64,
     ) {
-        let (p_try, q_try, gas_vol) = self.open(st, gas, h, per_h, flows, c_oil);
+        let (rhs, diag) = self.node(st, h, flows, c_oil);
+        let (p_try, q_try, gas_vol) = self.open(st, gas, h, per_h, (rhs, diag));
         if st.v <= 0.0 {
+            let p_shut = rhs / diag;
             // The poppet holds an empty absorber shut: no oil leaves it.
             if q_try < 0.0 {
-                st.q = 0.0;
-                st.v = 0.0;
-                st.g = gas.precharge_abs_pa();
-                st.p = self.closed(st, h, flows, c_oil);
+                shut(st, gas);
+                st.p = p_shut;
                 return;
             }
             let p_open = st.g - ATMOSPHERE_PA;
-            let p_shut = self.closed(st, h, flows, c_oil);
             if st.p < p_open && p_shut > p_open {
                 let before = h * (p_open - st.p) / (p_shut - st.p);
                 let after = h - before;
                 if after > EVENT_SHARE * h {
                     st.p = self.closed(st, before, flows, c_oil);
-                    let (p, q, v) = self.open(st, gas, after, 1.0 / after, flows, c_oil);
-                    self.take_open(st, gas, after, (p, q, v));
+                    let balance = self.node(st, after, flows, c_oil);
+                    let solved = self.open(st, gas, after, 1.0 / after, balance);
+                    take_open(st, gas, after, solved);
                     return;
                 }
             }
-        } else if st.v + h * q_try < 0.0 {
-            let before = h * st.v / (st.v - (st.v + h * q_try));
-            let after = h - before;
-            if before > EVENT_SHARE * h && after > EVENT_SHARE * h {
-                let (p, q, v) = self.open(st, gas, before, 1.0 / before, flows, c_oil);
-                self.take_open(st, gas, before, (p, q, v));
-                st.q = 0.0;
-                st.v = 0.0;
-                st.g = gas.precharge_abs_pa();
-                st.p = self.closed(st, after, flows, c_oil);
-                return;
+        } else {
+            let v_end = st.v + h * q_try;
+            if v_end < 0.0 {
+                let before = h * st.v / (st.v - v_end);
+                let after = h - before;
+                if before > EVENT_SHARE * h && after > EVENT_SHARE * h {
+                    let balance = self.node(st, before, flows, c_oil);
+                    st.p = self.open(st, gas, before, 1.0 / before, balance).0;
+                    shut(st, gas);
+                    st.p = self.closed(st, after, flows, c_oil);
+                    return;
+                }
             }
         }
-        self.take_open(st, gas, h, (p_try, q_try, gas_vol));
+        take_open(st, gas, h, (p_try, q_try, gas_vol));
     }
 
     /// The pressure, the inlet flow and the gas volume after `h` (`per_h` its reciprocal)
-    /// from `st` with the absorber's inlet open: backward Euler linearised about the gas.
+    /// from `st` with the absorber's inlet open, the node's balance over `h` being
+    /// `(rhs, diag)` ([`Self::node`]): backward Euler linearised about the gas.
     #[inline]
     fn open(
         &self,
@@ -107,11 +109,9 @@ impl Hydraulics {
         gas: &GasCharge,
         h: f64,
         per_h: f64,
-        flows: [f64; 4],
-        c_oil: f64,
+        (rhs, diag): (f64, f64),
     ) -> (f64, f64, f64) {
         let hp = &self.params;
-        let (rhs, diag) = self.node(st, h, flows, c_oil);
         // The inlet, (I + h·R + h²·k_g)·q' = I·q − h·p_gas + h·p' with the gas's
         // stiffness k_g = n·p_g/V_g, taken times V_g; with the node's
         // diag·p' = rhs − h·q' it gives p' in one division, and q' from the node
@@ -124,21 +124,30 @@ impl Hydraulics {
         let q_try = (rhs - diag * p_try) * per_h;
         (p_try, q_try, gas_vol)
     }
+}
 
-    /// `st` after `h` with the absorber open, from [`Self::open`]'s solution.
-    #[inline]
-    fn take_open(&self, st: &mut State, gas: &GasCharge, h: f64, solved: (f64, f64, f64)) {
-        let (p_try, q_try, gas_vol) = solved;
-        st.q = q_try;
-        let v_new = (st.v + h * q_try).max(0.0);
-        st.g = if v_new > 0.0 {
-            st.g + gas.exponent * st.g / gas_vol * (v_new - st.v)
-        } else {
-            gas.precharge_abs_pa()
-        };
-        st.v = v_new;
-        st.p = p_try;
-    }
+/// `st` after `h` with the absorber open, from [`Hydraulics::open`]'s pressure, inlet flow
+/// and gas volume.
+#[inline]
+fn take_open(st: &mut State, gas: &GasCharge, h: f64, solved: (f64, f64, f64)) {
+    let (p_try, q_try, gas_vol) = solved;
+    st.q = q_try;
+    let v_new = (st.v + h * q_try).max(0.0);
+    st.g = if v_new > 0.0 {
+        st.g + gas.exponent * st.g / gas_vol * (v_new - st.v)
+    } else {
+        gas.precharge_abs_pa()
+    };
+    st.v = v_new;
+    st.p = p_try;
+}
+
+/// The absorber shut and empty: no inlet flow, no oil, the gas at its precharge.
+#[inline]
+fn shut(st: &mut State, gas: &GasCharge) {
+    st.q = 0.0;
+    st.v = 0.0;
+    st.g = gas.precharge_abs_pa();
 }
 
 /// Least share of a substep an absorber's opening or closing is located at: an event
