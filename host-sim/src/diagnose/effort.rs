@@ -15,22 +15,28 @@
 //! fit spends there varies several-fold with the last bits of the arithmetic, and with it
 //! the diagnosis's time (`docs/diagnosis.md`, Speed).
 
-/// The optimiser's patience and tolerance.
+/// The optimiser's patience and tolerance, and how it takes its Jacobians.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Effort {
     /// Iterations per free parameter in each search. [1]
     pub patience: usize,
     /// Relative reduction of the objective (and of the step) below which a search stops. [1]
     pub tolerance: f64,
+    /// Whether the Jacobian may be carried between iterations by Broyden's update
+    /// ([`crate::diagnose::secant`]) instead of differenced at each: for fits whose
+    /// objectives only are compared, not their parameters reported.
+    pub secant: bool,
 }
 
 impl Effort {
     /// The decision's fits: three hundred-thousandths of an objective of 10⁴–10⁵ noise
     /// units is 0.3–3 units, below the χ² thresholds the decision compares differences
-    /// with; ten iterations per parameter bound the creep along the valleys.
+    /// with; ten iterations per parameter bound the creep along the valleys, whose short
+    /// steps take the Jacobian by Broyden's update between differencings.
     pub const SCREENING: Effort = Effort {
         patience: 10,
         tolerance: 3e-5,
+        secant: true,
     };
 
     /// The fits the report predicts with, polished from the screening's end: a
@@ -38,6 +44,7 @@ impl Effort {
     pub const REPORTED: Effort = Effort {
         patience: 10,
         tolerance: 1e-5,
+        secant: false,
     };
 
     /// The effort a fit stopped at this one is driven on to where its result decides or is
@@ -51,5 +58,6 @@ impl Effort {
     pub const THOROUGH: Effort = Effort {
         patience: 25,
         tolerance: 1e-5,
+        secant: false,
     };
 }

@@ -63,6 +63,7 @@ pub mod relations;
 mod release_tests;
 pub mod report;
 pub mod result;
+pub mod secant;
 pub mod selection;
 pub mod signatures;
 pub mod spectrum;
