@@ -69,9 +69,11 @@ struct Problem<'a, M: Model> {
     last: Mutex<Option<(Vec<f64>, Vec<f64>)>>,
     /// Free parameters found within [`AT_BOUND`] of a bound at an accepted point.
     reached: Mutex<Vec<usize>>,
-    /// The last Jacobian, for its update at the next accepted point; `None` inside when
-    /// every Jacobian is differenced.
-    secant: Option<Mutex<Option<Secant>>>,
+    /// Whether a differenced Jacobian is kept for its update at the next accepted point
+    /// ([`Effort::secant`]).
+    updates: bool,
+    /// The last Jacobian kept for that.
+    secant: Mutex<Option<Secant>>,
 }
 
 /// Where `u` lies in `spec`'s hard bounds, 0 at the lower and 1 at the upper. [1]
@@ -186,15 +188,8 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
             return None;
         }
         let (m, n) = (r0.len(), v0.len());
-        let mut secant = match &self.secant {
-            Some(s) => Some(s.lock().ok()?),
-            None => None,
-        };
-        if let Some(updated) = secant
-            .as_mut()
-            .and_then(|s| s.as_mut())
-            .and_then(|s| s.updated(&v0, &r0))
-        {
+        let mut secant = self.secant.lock().ok()?;
+        if let Some(updated) = secant.as_mut().and_then(|s| s.updated(&v0, &r0)) {
             return Some(DMatrix::from_vec(m, n, updated));
         }
         // Each column's difference quotient written straight into the matrix's storage
@@ -213,8 +208,8 @@ impl<M: Model> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, M> {
                     *c = (a - b) / h;
                 }
             });
-        if let Some(secant) = secant.as_mut() {
-            **secant = Some(Secant::differenced(v0, r0, storage.clone()));
+        if self.updates {
+            *secant = Some(Secant::differenced(v0, r0, storage.clone()));
         }
         Some(DMatrix::from_vec(m, n, storage))
     }
@@ -313,7 +308,8 @@ fn search<M: Model>(
         evaluations: AtomicUsize::new(0),
         last: Mutex::new(None),
         reached: Mutex::new(Vec::new()),
-        secant: effort.secant.then(|| Mutex::new(None)),
+        updates: effort.secant,
+        secant: Mutex::new(None),
     };
     let (problem, _report) = LevenbergMarquardt::<f64>::new()
         .with_patience(effort.patience)

@@ -527,14 +527,26 @@ mod tests {
         }
     }
 
+    /// The rig file's model sealed (no leakage), and its absorber's gas charge.
+    fn sealed() -> (HydraulicParams, GasCharge) {
+        let mut hp = HydraulicParams::nominal(&Rig::nominal());
+        hp.leakage_m3_s_pa = 0.0;
+        let gas = hp.absorber.expect("the rig file's absorber");
+        (hp, gas)
+    }
+
+    /// Oil stored in the sealed node between pressures `p0` and `p` by the volume balance:
+    /// the oil's compression plus the absorber's gas-law volume (eq. 22). [m³]
+    fn stored(hp: &HydraulicParams, gas: &GasCharge, p0: f64, p: f64) -> f64 {
+        (p - p0) * hp.high_side_volume_m3 / hp.bulk_modulus_pa + gas.oil_volume_m3(p)
+            - gas.oil_volume_m3(p0)
+    }
+
     #[test]
     fn above_precharge_the_absorber_adds_the_gas_law_capacitance() {
         // Quasi-static filling from 4 to ~4.2 MPa: the volume displaced equals the oil
         // compressed plus the absorber's gas-law volume change (eq. 22), to 1 %.
-        let rig = Rig::nominal();
-        let mut hp = HydraulicParams::nominal(&rig);
-        hp.leakage_m3_s_pa = 0.0;
-        let gas = hp.absorber.unwrap();
+        let (hp, gas) = sealed();
         let n = 3000;
         let t: Vec<f64> = (0..n).map(|k| k as f64 * 1e-3).collect();
         // 2 mL over 3 s.
@@ -542,10 +554,7 @@ mod tests {
         let w = 2e-6 / 3.0 / per_rad;
         let th: Vec<f64> = t.iter().map(|t| w * t).collect();
         let out = open_loop(&hp, &t, &th, 0.5e6, 4e6);
-        let p1 = out[n - 1];
-        let stored = (p1 - 4e6) * hp.high_side_volume_m3 / hp.bulk_modulus_pa
-            + gas.oil_volume_m3(p1)
-            - gas.oil_volume_m3(4e6);
+        let stored = stored(&hp, &gas, 4e6, out[n - 1]);
         let displaced = per_rad * th[n - 1];
         assert!(
             (stored / displaced - 1.0).abs() < 0.01,
@@ -563,10 +572,7 @@ mod tests {
         // inlet's resistance holds the pressure R·Q = 420 Pa off that quasi-static curve
         // while the absorber flows and the inertance starts that flow; once shut, the
         // curve is exact.
-        let rig = Rig::nominal();
-        let mut hp = HydraulicParams::nominal(&rig);
-        hp.leakage_m3_s_pa = 0.0;
-        let gas = hp.absorber.unwrap();
+        let (hp, gas) = sealed();
         let per_rad = hp.displacement_m3_per_rev / (2.0 * PI);
         let q = 1.4e-5;
         let n = 401;
@@ -574,13 +580,11 @@ mod tests {
         let th: Vec<f64> = t.iter().map(|t| -q / per_rad * t).collect();
         let p0 = 3.05e6;
         let out = open_loop(&hp, &t, &th, 0.5e6, p0);
-        let c_oil = hp.high_side_volume_m3 / hp.bulk_modulus_pa;
-        let stored = |p: f64| c_oil * (p - p0) + gas.oil_volume_m3(p) - gas.oil_volume_m3(p0);
         let exact = |t: f64| {
             let (mut lo, mut hi) = (0.0, p0);
             for _ in 0..200 {
                 let mid = 0.5 * (lo + hi);
-                if stored(mid) > -q * t {
+                if stored(&hp, &gas, p0, mid) > -q * t {
                     hi = mid;
                 } else {
                     lo = mid;
