@@ -3,31 +3,38 @@
 //! [1e-5, 1e16) and zero, exponent notation (`{:e}`) beyond, where positional would spell
 //! out dozens of zeros.
 //!
-//! The text comes from the `ryu` crate (Ryū, Adams 2018: the shortest round-trip digits,
-//! the nearest of them when several are as short — the digits Rust's formatter chooses too),
-//! at a fraction of the cost of `core::fmt`'s Grisu/Dragon path: formatting a log's numbers
-//! took a fifth of an `eha simulate` run. Ryū's layout is Rust's but for a whole number's
-//! trailing `.0` (`100.0` where Rust writes `100`): the same positional range (the decimal
-//! point between 4 places before the first digit and 16 after it), the same exponent
-//! notation (`1e-7`, `1.234e33`). So the text is Ryū's with that suffix dropped, byte for
-//! byte what `write!(s, "{v}")` or `write!(s, "{v:e}")` gives (checked against them in the
-//! tests below), except where two shortest decimals may be equally near, which Rust's own
+//! The digits come from the `zmij` crate (Schubfach with a fast path: the shortest
+//! round-trip digits, the nearest of them when several are as short — the digits Rust's
+//! formatter chooses too), at a fraction of the cost of `core::fmt`'s Grisu/Dragon path and
+//! about half of Ryū's. Its layout is Rust's but for a whole number's trailing `.0` (`100.0`
+//! where Rust writes `100`) and a positive exponent's sign (`1e+16` where Rust writes
+//! `1e16`): the same positional range (the decimal point between 4 places before the first
+//! digit and 16 after it), the same exponent notation otherwise (`1e-7`, `1.234e33`). So the
+//! text is zmij's with that suffix and that sign dropped, byte for byte what
+//! `write!(s, "{v}")` or `write!(s, "{v:e}")` gives (checked against them in the tests
+//! below), except where two shortest decimals may be equally near, which Rust's own
 //! formatting spells.
 
 /// Appends the text of `v` to `out`.
 pub fn push(out: &mut String, v: f64) {
-    let mut buf = ryu::Buffer::new();
+    let mut buf = zmij::Buffer::new();
     match spell(&mut buf, v) {
-        Some(text) => out.push_str(text),
+        Some([head, tail]) => {
+            out.push_str(head);
+            out.push_str(tail);
+        }
         None => push_std(out, v),
     }
 }
 
 /// Appends the text of `v` to the bytes `out`.
 pub fn push_bytes(out: &mut Vec<u8>, v: f64) {
-    let mut buf = ryu::Buffer::new();
+    let mut buf = zmij::Buffer::new();
     match spell(&mut buf, v) {
-        Some(text) => out.extend_from_slice(text.as_bytes()),
+        Some([head, tail]) => {
+            out.extend_from_slice(head.as_bytes());
+            out.extend_from_slice(tail.as_bytes());
+        }
         None => {
             let mut s = String::new();
             push_std(&mut s, v);
@@ -48,19 +55,29 @@ fn push_std(out: &mut String, v: f64) {
     };
 }
 
-/// The text of `v` from Ryū in `buf`, or `None` where Rust's own formatting must spell it
-/// (not finite, or possibly a tie).
+/// The text of `v` from zmij in `buf`, in two pieces to be written one after the other (the
+/// second empty but for a positive exponent, whose sign falls between them), or `None` where
+/// Rust's own formatting must spell it (not finite, or possibly a tie).
 #[inline]
-fn spell(buf: &mut ryu::Buffer, v: f64) -> Option<&str> {
+fn spell(buf: &mut zmij::Buffer, v: f64) -> Option<[&str; 2]> {
     if !v.is_finite() {
         return None;
     }
     let text = buf.format_finite(v);
     let text = text.strip_suffix(".0").unwrap_or(text);
-    (!maybe_tie(v, text.as_bytes())).then_some(text)
+    if maybe_tie(v, text.as_bytes()) {
+        return None;
+    }
+    // Only magnitudes from 1e16 on are written with a positive exponent.
+    if v.abs() >= 1e16 {
+        if let Some(k) = text.find("e+") {
+            return Some([&text[..=k], &text[k + 2..]]);
+        }
+    }
+    Some([text, ""])
 }
 
-/// Whether Ryū's `text` for `v` may be one of two equally near shortest decimals (Ryū then
+/// Whether zmij's `text` for `v` may be one of two equally near shortest decimals (zmij then
 /// takes the even one, Rust's formatting not necessarily). Equally near n-digit decimals
 /// are neighbours (any between them would be nearer) and `v` is their midpoint: its exact
 /// decimal expansion has n + 1 significant digits. The exact value m·2^e (m odd) is an
@@ -96,7 +113,7 @@ fn maybe_tie(v: f64, text: &[u8]) -> bool {
     point - e == n + 1
 }
 
-/// The number of significant digits of Ryū's `text` (finite, non-zero, its whole number's
+/// The number of significant digits of zmij's `text` (finite, non-zero, its whole number's
 /// `.0` dropped) and the place of its decimal point (value = 0.d₁d₂… × 10^point).
 fn digits_and_point(text: &[u8]) -> (i32, i32) {
     let body = text.strip_prefix(b"-").unwrap_or(text);
@@ -106,7 +123,7 @@ fn digits_and_point(text: &[u8]) -> (i32, i32) {
             let rest = &rest[1..];
             let (neg, digits) = match rest.strip_prefix(b"-") {
                 Some(d) => (true, d),
-                None => (false, rest),
+                None => (false, rest.strip_prefix(b"+").unwrap_or(rest)),
             };
             let x = digits
                 .iter()
@@ -207,7 +224,7 @@ mod tests {
     #[test]
     fn text_is_rusts_own_for_short_binary_fractions() {
         // Values with few exact decimal digits (m·2^−k, m small) hold the midpoints of two
-        // shortest decimals, where Ryū and Rust may choose differently.
+        // shortest decimals, where zmij and Rust may choose differently.
         for k in 1..80 {
             for m in [
                 1u64,
