@@ -260,7 +260,12 @@ impl Conditions {
     }
 
     /// The present condition with the lowest code (the most basic cause first).
+    #[inline]
     pub fn first(self) -> Option<FaultCode> {
+        // Nearly every sample has none: no scan of the codes then.
+        if self.0 == 0 {
+            return None;
+        }
         FaultCode::ALL.iter().copied().find(|f| self.has(*f))
     }
 }
