@@ -451,3 +451,35 @@ fn accumulator_design_writes_json_file_and_prints_the_table() {
     assert_eq!(status(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("no/such/dir"), "{}", stderr(&o));
 }
+
+#[test]
+fn simulate_reports_its_real_time_factors_consistently() {
+    // The command's own wall clock holds the closed loop's, and the log's spelling and
+    // writing besides: its factor is the duration over its wall time and never above the
+    // loop's; the comparison run reports its scheme and the ratio of the CPU factors.
+    let dir = scratch("simulate-json");
+    let out = dir.join("hold.csv");
+    let o = eha(&[
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "0.5",
+        "--out",
+        s(&out),
+        "--compare-integrator",
+        "rk4",
+        "--json",
+        "-",
+    ]);
+    assert_eq!(status(&o), 0, "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let (wall, command) = (f(&v, "command_wall_s"), f(&v, "command_real_time_factor"));
+    assert!(wall > 0.0 && close(command, 0.5 / wall, 1e-9), "{v}");
+    assert!(command <= f(&v, "real_time_factor"), "{v}");
+    let c = &v["compared"];
+    assert_eq!(c["integrator"], "rk4", "{v}");
+    let ratio = f(&v, "cpu_real_time_factor") / f(c, "cpu_real_time_factor");
+    assert!(close(f(c, "speedup"), ratio, 1e-9), "{v}");
+    assert!(fs::metadata(&out).is_ok_and(|m| m.len() > 0));
+}

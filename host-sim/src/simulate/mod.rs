@@ -273,6 +273,9 @@ fn check_log_length(duration_s: f64, log_rate_hz: f64, period_s: f64) -> Result<
 
 /// `eha simulate`.
 pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
+    // The command's own wall clock (rig, closed loop, log spelt and written; the comparison
+    // run's time taken out): the real-time factor a user of the command sees.
+    let started = std::time::Instant::now();
     if args.list {
         let mut s = String::new();
         for sc in SCENARIOS.iter().chain(&PROCEDURES) {
@@ -384,6 +387,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         .map_err(CliError::Failed)
         .and_then(|r| converged(r, args.plant_rig.as_deref()))?;
     // The same run with the other scheme, for the ratio of their speeds in this process.
+    let comparing = std::time::Instant::now();
     let compared = match args.compare_integrator {
         Some(other) => {
             let o = run(
@@ -402,8 +406,10 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         }
         None => None,
     };
+    let comparison = comparing.elapsed();
     let mut outputs = Outputs::new();
     bench_log::stage(&mut outputs, "--out", out, &r.log)?;
+    let command_s = started.elapsed().saturating_sub(comparison).as_secs_f64();
     if let Some(json_path) = &args.json {
         let mut summary = json!({
             "scenario": scenario.name,
@@ -412,6 +418,8 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
             "out": out.display().to_string(),
             "real_time_factor": r.real_time_factor,
             "cpu_real_time_factor": r.cpu_real_time_factor,
+            "command_wall_s": command_s,
+            "command_real_time_factor": duration / command_s.max(1e-9),
             "integrator": args.integrator.name(),
         });
         if let Some((other, o)) = &compared {
