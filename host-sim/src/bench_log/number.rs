@@ -77,8 +77,8 @@ fn spell(buf: &mut zmij::Buffer, v: f64) -> Option<[&str; 2]> {
     Some([text, ""])
 }
 
-/// Whether zmij's `text` for `v` may be one of two equally near shortest decimals (zmij then
-/// takes the even one, Rust's formatting not necessarily). Equally near n-digit decimals
+/// Whether zmij's `text` for `v` may be one of two equally near shortest decimals (which
+/// of the two a formatter takes is its own rule: zmij's and Rust's need not agree). Equally near n-digit decimals
 /// are neighbours (any between them would be nearer) and `v` is their midpoint: its exact
 /// decimal expansion has n + 1 significant digits. The exact value m·2^e (m odd) is an
 /// integer for e ≥ 0, never such a midpoint; for e < 0 it has −e fractional digits, so
