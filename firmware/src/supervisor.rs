@@ -259,14 +259,14 @@ impl Conditions {
         self.0 & f.bit() != 0
     }
 
-    /// The present condition with the lowest code (the most basic cause first).
+    /// The present condition with the lowest code (the most basic cause first): the lowest
+    /// set bit, since [`FaultCode::ALL`] is in bit order (none when no bit, or only bits no
+    /// code has, are set).
     #[inline]
     pub fn first(self) -> Option<FaultCode> {
-        // Nearly every sample has none: no scan of the codes then.
-        if self.0 == 0 {
-            return None;
-        }
-        FaultCode::ALL.iter().copied().find(|f| self.has(*f))
+        FaultCode::ALL
+            .get(self.0.trailing_zeros() as usize)
+            .copied()
     }
 }
 
@@ -464,6 +464,25 @@ pub enum ModeRefusal {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_first_condition_is_the_lowest_code_present() {
+        // Every pair of codes, and each with a bit no code has above it: the lower code of
+        // the pair, whatever else is set; nothing from no bit or from unknown bits alone.
+        assert_eq!(Conditions(0).first(), None);
+        assert_eq!(Conditions(1 << 31 | 1 << 25).first(), None);
+        for a in FaultCode::ALL {
+            let alone = Conditions(a.bit() | 1 << 30);
+            assert_eq!(alone.first(), Some(a));
+            for b in FaultCode::ALL {
+                let mut c = Conditions::default();
+                c.set(a, true);
+                c.set(b, true);
+                let lower = if a.code() < b.code() { a } else { b };
+                assert_eq!(c.first(), Some(lower), "{a:?} and {b:?}");
+            }
+        }
+    }
 
     #[test]
     fn codes_round_trip_and_bits_are_distinct() {

@@ -87,16 +87,13 @@ impl Secant {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::{DMatrix, DVector};
 
-    /// Column-major m×n matrix times a vector.
+    /// Column-major m×n matrix times a vector (nalgebra's product, independent of the
+    /// update's own loops).
     fn times(j: &[f64], m: usize, x: &[f64]) -> Vec<f64> {
-        let mut y = vec![0.0; m];
-        for (column, x) in j.chunks_exact(m).zip(x) {
-            for (y, c) in y.iter_mut().zip(column) {
-                *y += c * x;
-            }
-        }
-        y
+        let a = DMatrix::from_column_slice(m, x.len(), j);
+        (a * DVector::from_column_slice(x)).as_slice().to_vec()
     }
 
     #[test]
