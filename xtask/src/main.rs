@@ -4,7 +4,10 @@
 //! 1. what it needs installed when missing ([`setup`]): the `thumbv7em-none-eabihf` target
 //!    (rustup), the `flip-link` linker (cargo install), `qemu-system-arm` and `tmux`
 //!    (apt-get), Python's `cantools`, `dask` and `distributed` (a virtual environment);
-//! 2. `cargo fmt --check` and `cargo clippy --workspace --all-targets -D warnings`;
+//! 2. `cargo fmt --check`; every target of the workspace built for the host with Clippy's
+//!    lints, warnings denied, in the same compilation ([`workspace::linted_cargo`]: what
+//!    `cargo clippy --workspace --all-targets -- -D warnings` checks, without checking every
+//!    crate a second time);
 //! 3. the host tests of the whole workspace, and `eha fleet` against its Dask driver on a
 //!    local two-worker cluster and against its shards ([`fleet_check`]);
 //! 4. the CAN DBC file: in sync with `firmware::can_protocol` ([`dbc`]), and cantools
@@ -36,7 +39,7 @@ mod workspace;
 
 use anyhow::Result;
 use firmware_image::{ensure_target, firmware};
-use workspace::{cargo, root, run};
+use workspace::{cargo, linted_cargo, root, run};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -80,22 +83,22 @@ fn test() -> Result<()> {
     times.step("format", || {
         run("format", cargo().args(["fmt", "--all", "--", "--check"]))
     })?;
-    times.step("lint", || {
+    // Every target: what the test runs need (`--all-targets` would build the examples a
+    // second time, as tests), then the benchmarks.
+    times.step("lint, build", || {
+        let step = "host build, Clippy's lints with warnings denied";
         run(
-            "lint",
-            cargo().args([
-                "clippy",
-                "--workspace",
-                "--all-targets",
-                "--",
-                "-D",
-                "warnings",
-            ]),
+            step,
+            linted_cargo()?.args(["test", "--workspace", "--no-run"]),
+        )?;
+        run(
+            step,
+            linted_cargo()?.args(["test", "--workspace", "--benches", "--no-run"]),
         )
     })?;
     times.step("rooms", || rooms::rooms(&[]))?;
     times.step("host tests", || {
-        run("host tests", cargo().args(["test", "--workspace"]))
+        run("host tests", linted_cargo()?.args(["test", "--workspace"]))
     })?;
     times.step("fleet", || fleet_check::check(&python))?;
     times.step("can", || {

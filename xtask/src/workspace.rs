@@ -1,5 +1,6 @@
 //! The workspace the tasks run in: its root, Cargo's target directory, a `cargo` command
-//! started at the root, and the runner of one step that names the step when it fails.
+//! started at the root (plain, or linting the workspace's crates as it builds them), and the
+//! runner of one step that names the step when it fails.
 
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -18,6 +19,48 @@ pub fn cargo() -> Command {
     let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     c.current_dir(root());
     c
+}
+
+/// Clippy's arguments as `cargo clippy -- -D warnings` hands them to `clippy-driver`: its
+/// `CLIPPY_ARGS`, each argument followed by Clippy's separator.
+const CLIPPY_ARGS: &str = "-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__";
+
+/// `cargo` for the host's builds, linting as it builds: the workspace's own crates are
+/// compiled by `clippy-driver` (rustc with Clippy's lints, every warning denied) instead of
+/// rustc, the way `cargo clippy` runs it (`RUSTC_WORKSPACE_WRAPPER`, `CLIPPY_ARGS`), and the
+/// dependencies by rustc as in any build. One compilation both lints the code and makes the
+/// test binaries, where `cargo clippy` followed by `cargo test` checked every crate once more
+/// without building it. Every host build of the tasks goes through here, so none of them
+/// rebuilds what another built.
+pub fn linted_cargo() -> Result<Command> {
+    let mut c = cargo();
+    c.env("RUSTC_WORKSPACE_WRAPPER", clippy_driver()?)
+        .env("CLIPPY_ARGS", CLIPPY_ARGS);
+    Ok(c)
+}
+
+/// The `clippy-driver` of the toolchain running this task: beside its `cargo`, else where
+/// rustup says it is.
+fn clippy_driver() -> Result<PathBuf> {
+    let name = format!("clippy-driver{}", std::env::consts::EXE_SUFFIX);
+    if let Some(cargo) = std::env::var_os("CARGO") {
+        let beside = Path::new(&cargo).with_file_name(&name);
+        if beside.is_file() {
+            return Ok(beside);
+        }
+    }
+    match Command::new("rustup")
+        .args(["which", "clippy-driver"])
+        .output()
+    {
+        Ok(out) if out.status.success() => {
+            Ok(PathBuf::from(String::from_utf8_lossy(&out.stdout).trim()))
+        }
+        _ => bail!(
+            "{name} is missing: the host's builds are linted by Clippy as they compile. \
+             Install it with `rustup component add clippy`"
+        ),
+    }
 }
 
 /// Cargo's target directory (`CARGO_TARGET_DIR` or `target/` at the root).
@@ -40,10 +83,13 @@ pub fn run(step: &str, cmd: &mut Command) -> Result<()> {
 }
 
 /// `eha` as the host tests build it (their integration tests run it), built if needed:
-/// right after `cargo test --workspace` nothing is rebuilt, where `cargo build -p host-sim`
-/// would resolve the dependencies' features without the workspace's dev-dependencies and
-/// compile them all again.
+/// right after the host tests nothing is rebuilt, where `cargo build -p host-sim` would
+/// resolve the dependencies' features without the workspace's dev-dependencies and compile
+/// them all again (and a build without Clippy would compile the workspace's crates again).
 pub fn eha_binary(step: &str) -> Result<PathBuf> {
-    run(step, cargo().args(["test", "--workspace", "--no-run"]))?;
+    run(
+        step,
+        linted_cargo()?.args(["test", "--workspace", "--no-run"]),
+    )?;
     Ok(target_dir().join("debug").join("eha"))
 }
