@@ -31,20 +31,14 @@ const CLIPPY_ARGS: &str = "-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__";
 /// dependencies by rustc as in any build. One compilation both lints the code and makes the
 /// test binaries, where `cargo clippy` followed by `cargo test` checked every crate once more
 /// without building it. Every host build of the tasks goes through here, so none of them
-/// rebuilds what another built. The build lives in [`linted_target_dir`].
+/// rebuilds what another built, and xtask's own dependencies are reused. Cargo fingerprints
+/// the wrapper: a plain `cargo test` in the same target directory compiles the workspace's
+/// crates again (not their dependencies), and so do the tasks after it.
 pub fn linted_cargo() -> Result<Command> {
     let mut c = cargo();
     c.env("RUSTC_WORKSPACE_WRAPPER", clippy_driver()?)
-        .env("CLIPPY_ARGS", CLIPPY_ARGS)
-        .env("CARGO_TARGET_DIR", linted_target_dir());
+        .env("CLIPPY_ARGS", CLIPPY_ARGS);
     Ok(c)
-}
-
-/// Where [`linted_cargo`] builds: a target directory of its own inside Cargo's. Cargo
-/// fingerprints the compiler wrapper, so in one directory a plain `cargo test` after the
-/// tasks (or the tasks after it) would compile every crate of the workspace again.
-pub fn linted_target_dir() -> PathBuf {
-    target_dir().join("linted")
 }
 
 /// The `clippy-driver` of the toolchain running this task: beside its `cargo`, else where
@@ -99,5 +93,5 @@ pub fn eha_binary(step: &str) -> Result<PathBuf> {
         step,
         linted_cargo()?.args(["test", "--workspace", "--no-run"]),
     )?;
-    Ok(linted_target_dir().join("debug").join("eha"))
+    Ok(target_dir().join("debug").join("eha"))
 }
