@@ -7,7 +7,8 @@
 //! 2. `cargo fmt --check`; every target of the workspace built for the host with Clippy's
 //!    lints, warnings denied, in the same compilation ([`workspace::linted_cargo`]: what
 //!    `cargo clippy --workspace --all-targets -- -D warnings` checks, without checking every
-//!    crate a second time);
+//!    crate a second time), the unit tests of the optimised simulation libraries compiled
+//!    unoptimised ([`compiler`]);
 //! 3. the host tests of the whole workspace, and `eha fleet` against its Dask driver on a
 //!    local two-worker cluster and against its shards ([`fleet_check`]);
 //! 4. the CAN DBC file: in sync with `firmware::can_protocol` ([`dbc`]), and cantools
@@ -28,6 +29,7 @@
 //! the import circles between files ([`rooms`]).
 
 mod can_check;
+mod compiler;
 mod dbc;
 mod firmware_image;
 mod fleet_check;
@@ -42,6 +44,7 @@ use firmware_image::{ensure_target, firmware};
 use workspace::{cargo, linted_cargo, root, run};
 
 fn main() {
+    compiler::wrap_if_called();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("test") => test(),

@@ -2,6 +2,7 @@
 //! started at the root (plain, or linting the workspace's crates as it builds them), and the
 //! runner of one step that names the step when it fails.
 
+use crate::compiler;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -34,9 +35,16 @@ const CLIPPY_ARGS: &str = "-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__";
 /// rebuilds what another built, and xtask's own dependencies are reused. Cargo fingerprints
 /// the wrapper: a plain `cargo test` in the same target directory compiles the workspace's
 /// crates again (not their dependencies), and so do the tasks after it.
+///
+/// Cargo runs this task's own executable as the wrapper, which hands each call to
+/// `clippy-driver` and leaves the unit tests of the optimised simulation libraries
+/// unoptimised ([`crate::compiler`]).
 pub fn linted_cargo() -> Result<Command> {
     let mut c = cargo();
-    c.env("RUSTC_WORKSPACE_WRAPPER", clippy_driver()?)
+    let wrapper =
+        std::env::current_exe().context("this task's executable, the compiler wrapper")?;
+    c.env("RUSTC_WORKSPACE_WRAPPER", wrapper)
+        .env(compiler::DRIVER_VAR, clippy_driver()?)
         .env("CLIPPY_ARGS", CLIPPY_ARGS);
     Ok(c)
 }
