@@ -2,15 +2,16 @@
 //! (rustc with Clippy's lints), reached through this task's own executable, which leaves the
 //! unit tests of the simulation's libraries unoptimised.
 //!
-//! The dev profile optimises `host-sim` and `plant-model` (Cargo.toml): their integration
-//! tests run long closed-loop simulations and the diagnosis's fits. Their unit-test crates
-//! are each the whole library compiled again with its tests, and under `cargo test` every
-//! unit takes the same profile, so they were compiled at opt-level 3 as well, though their
-//! tests are small checks that run in seconds either way. Cargo has no setting per target,
-//! so the wrapper Cargo runs for the workspace's crates (`RUSTC_WORKSPACE_WRAPPER`) appends
-//! `-C opt-level=0` to those two compilations (rustc takes a codegen option's last value)
-//! and hands every call to `clippy-driver` unchanged otherwise. Optimisation does not change
-//! a floating-point result here (no fast-math), so the tests check the same numbers.
+//! The dev profile optimises `host-sim`, `plant-model` and `closed-loop` (Cargo.toml): their
+//! integration tests run long closed-loop simulations and the diagnosis's fits. Their
+//! unit-test crates are each the whole library compiled again with its tests, and under
+//! `cargo test` every unit takes the same profile, so a plain build compiles them at
+//! opt-level 3 as well, though their tests are small checks that run in seconds either way.
+//! Cargo has no setting per target, so the wrapper Cargo runs for the workspace's crates
+//! (`RUSTC_WORKSPACE_WRAPPER`) appends `-C opt-level=0` to those compilations (rustc takes a
+//! codegen option's last value) and hands every call to `clippy-driver` unchanged otherwise.
+//! Optimisation does not change a floating-point result here (no fast-math), so the tests
+//! check the same numbers.
 //!
 //! Cargo calls the wrapper as `WRAPPER RUSTC ARGS…`; this executable knows the call by
 //! [`DRIVER_VAR`] in its environment, set only by [`crate::workspace::linted_cargo`], and
@@ -26,7 +27,7 @@ use std::process::Command;
 pub const DRIVER_VAR: &str = "EHA_XTASK_CLIPPY_DRIVER";
 
 /// Crates (rustc's names) whose unit-test build is left unoptimised.
-pub const UNOPTIMISED_UNIT_TESTS: [&str; 2] = ["host_sim", "plant_model"];
+pub const UNOPTIMISED_UNIT_TESTS: [&str; 3] = ["host_sim", "plant_model", "closed_loop"];
 
 /// When this process is Cargo's compiler wrapper, runs the compiler and exits with its
 /// status; otherwise returns.
@@ -86,6 +87,8 @@ mod tests {
         assert!(unoptimised(&call(unit)));
         let plant = "rustc --crate-name plant_model --test plant-model/src/lib.rs";
         assert!(unoptimised(&call(plant)));
+        let seam = "rustc --crate-name closed_loop --test closed-loop/src/lib.rs";
+        assert!(unoptimised(&call(seam)));
         // The library itself, as the integration tests link it.
         let lib = "rustc --crate-name host_sim --crate-type lib host-sim/src/lib.rs -C opt-level=3";
         assert!(!unoptimised(&call(lib)));
