@@ -1,23 +1,23 @@
 //! The compiler the linted host build runs for the workspace's own crates: `clippy-driver`
-//! (rustc with Clippy's lints), reached through this task's own executable, which leaves the
-//! unit tests of the simulation's libraries unoptimised.
+//! (rustc with Clippy's lints), reached through this task's own executable, which compiles
+//! the unit tests of the optimised libraries at a lower optimisation level.
 //!
-//! The dev profile optimises `host-sim`, `plant-model` and `closed-loop` (Cargo.toml): their
-//! integration tests run long closed-loop simulations and the diagnosis's fits. Their
-//! unit-test crates are each the whole library compiled again with its tests, and under
-//! `cargo test` every unit takes the same profile, so a plain build compiles them at
-//! opt-level 3 as well, though their tests are small checks that run in seconds either way.
-//! Cargo has no setting per target, so the wrapper Cargo runs for the workspace's crates
-//! (`RUSTC_WORKSPACE_WRAPPER`) appends `-C opt-level=0` to those compilations (rustc takes a
-//! codegen option's last value) and hands every call to `clippy-driver` unchanged otherwise.
-//! Optimisation does not change a floating-point result here (no fast-math), so the tests
-//! check the same numbers.
+//! The dev profile optimises `host-sim`, `plant-model`, `closed-loop` and `firmware`
+//! (Cargo.toml): their integration tests run long closed-loop simulations and the
+//! diagnosis's fits. Their unit-test crates are each the whole library compiled again with
+//! its tests, and under `cargo test` every unit takes the same profile, so a plain build
+//! compiles them at opt-level 3 as well, though their tests are small checks that run in
+//! seconds either way. Cargo has no setting per target, so the wrapper Cargo runs for the
+//! workspace's crates (`RUSTC_WORKSPACE_WRAPPER`) appends a lower `-C opt-level` to those
+//! compilations ([`UNIT_TEST_OPT_LEVELS`]; rustc takes a codegen option's last value) and
+//! hands every call to `clippy-driver` unchanged otherwise. Optimisation does not change a
+//! floating-point result here (no fast-math), so the tests check the same numbers.
 //!
 //! Cargo calls the wrapper as `WRAPPER RUSTC ARGS…`; this executable knows the call by
 //! [`DRIVER_VAR`] in its environment, set only by [`crate::workspace::linted_cargo`], and
 //! a first argument naming rustc. Cargo fingerprints the wrapper by its path, not by what
-//! it does: a change of [`UNOPTIMISED_UNIT_TESTS`] reaches a crate already built at its
-//! next change (only the build's time depends on it).
+//! it does: a change of [`UNIT_TEST_OPT_LEVELS`] reaches a crate already built at its next
+//! change (only the build's time depends on it).
 
 use std::ffi::{OsStr, OsString};
 use std::path::Path;
@@ -26,8 +26,15 @@ use std::process::Command;
 /// Environment variable holding the `clippy-driver` the wrapper hands its calls to.
 pub const DRIVER_VAR: &str = "EHA_XTASK_CLIPPY_DRIVER";
 
-/// Crates (rustc's names) whose unit-test build is left unoptimised.
-pub const UNOPTIMISED_UNIT_TESTS: [&str; 3] = ["host_sim", "plant_model", "closed_loop"];
+/// Crates (rustc's names) whose unit-test build takes a lower optimisation level, and that
+/// level: none at all where the tests run as fast unoptimised, 1 for the firmware's, whose
+/// 157 tests run several times slower at 0 than the build saves.
+pub const UNIT_TEST_OPT_LEVELS: [(&str, &str); 4] = [
+    ("host_sim", "0"),
+    ("plant_model", "0"),
+    ("closed_loop", "0"),
+    ("firmware", "1"),
+];
 
 /// When this process is Cargo's compiler wrapper, runs the compiler and exits with its
 /// status; otherwise returns.
@@ -45,8 +52,8 @@ pub fn wrap_if_called() {
     }
     let mut cmd = Command::new(&driver);
     cmd.args(&args);
-    if unoptimised(&args) {
-        cmd.arg("-Copt-level=0");
+    if let Some(level) = unit_test_opt_level(&args) {
+        cmd.arg(format!("-Copt-level={level}"));
     }
     let code = match cmd.status() {
         Ok(status) => status.code().unwrap_or(1),
@@ -61,15 +68,20 @@ pub fn wrap_if_called() {
     std::process::exit(code);
 }
 
-/// Whether the compiler call `args` builds the unit tests (`--test`) of one of
-/// [`UNOPTIMISED_UNIT_TESTS`].
-fn unoptimised(args: &[OsString]) -> bool {
+/// The optimisation level of the compiler call `args` when it builds the unit tests
+/// (`--test`) of one of [`UNIT_TEST_OPT_LEVELS`].
+fn unit_test_opt_level(args: &[OsString]) -> Option<&'static str> {
+    if !args.iter().any(|a| a == "--test") {
+        return None;
+    }
     let crate_name = args
         .windows(2)
         .find(|w| w[0] == "--crate-name")
-        .map(|w| w[1].as_os_str());
-    args.iter().any(|a| a == "--test")
-        && crate_name.is_some_and(|n| UNOPTIMISED_UNIT_TESTS.iter().any(|u| n == OsStr::new(u)))
+        .map(|w| w[1].as_os_str())?;
+    UNIT_TEST_OPT_LEVELS
+        .iter()
+        .find(|(name, _)| crate_name == OsStr::new(name))
+        .map(|(_, level)| *level)
 }
 
 #[cfg(test)]
@@ -81,24 +93,36 @@ mod tests {
     }
 
     #[test]
-    fn only_the_listed_unit_tests_are_left_unoptimised() {
+    fn only_the_listed_unit_tests_take_a_lower_level() {
+        let level = |line: &str| unit_test_opt_level(&call(line));
         let unit =
             "rustc --crate-name host_sim --edition=2021 host-sim/src/lib.rs --test -C opt-level=3";
-        assert!(unoptimised(&call(unit)));
-        let plant = "rustc --crate-name plant_model --test plant-model/src/lib.rs";
-        assert!(unoptimised(&call(plant)));
-        let seam = "rustc --crate-name closed_loop --test closed-loop/src/lib.rs";
-        assert!(unoptimised(&call(seam)));
+        assert_eq!(level(unit), Some("0"));
+        assert_eq!(
+            level("rustc --crate-name plant_model --test p/src/lib.rs"),
+            Some("0")
+        );
+        assert_eq!(
+            level("rustc --crate-name closed_loop --test c/src/lib.rs"),
+            Some("0")
+        );
+        assert_eq!(
+            level("rustc --crate-name firmware --test f/src/lib.rs"),
+            Some("1")
+        );
         // The library itself, as the integration tests link it.
         let lib = "rustc --crate-name host_sim --crate-type lib host-sim/src/lib.rs -C opt-level=3";
-        assert!(!unoptimised(&call(lib)));
+        assert_eq!(level(lib), None);
         // An integration test of host-sim, another crate's unit tests.
-        let integration = "rustc --crate-name bad_input host-sim/tests/bad_input.rs --test";
-        assert!(!unoptimised(&call(integration)));
-        let firmware = "rustc --crate-name firmware firmware/src/lib.rs --test";
-        assert!(!unoptimised(&call(firmware)));
+        assert_eq!(
+            level("rustc --crate-name bad_input tests/bad_input.rs --test"),
+            None
+        );
+        assert_eq!(
+            level("rustc --crate-name tests tests/src/lib.rs --test"),
+            None
+        );
         // A crate whose name only contains a listed one.
-        let longer = "rustc --crate-name host_sim_extra --test x.rs";
-        assert!(!unoptimised(&call(longer)));
+        assert_eq!(level("rustc --crate-name host_sim_extra --test x.rs"), None);
     }
 }

@@ -8,7 +8,7 @@
 //!    lints, warnings denied, in the same compilation ([`workspace::linted_cargo`]: what
 //!    `cargo clippy --workspace --all-targets -- -D warnings` checks, without checking every
 //!    crate a second time), the unit tests of the optimised simulation libraries compiled
-//!    unoptimised ([`compiler`]);
+//!    at a lower optimisation level ([`compiler`]);
 //! 3. the host tests of the whole workspace, and `eha fleet` against its Dask driver on a
 //!    local two-worker cluster and against its shards ([`fleet_check`]);
 //! 4. the CAN DBC file: in sync with `firmware::can_protocol` ([`dbc`]), and cantools

@@ -37,8 +37,8 @@ const CLIPPY_ARGS: &str = "-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__";
 /// crates again (not their dependencies), and so do the tasks after it.
 ///
 /// Cargo runs this task's own executable as the wrapper, which hands each call to
-/// `clippy-driver` and leaves the unit tests of the optimised simulation libraries
-/// unoptimised ([`crate::compiler`]).
+/// `clippy-driver` and compiles the unit tests of the optimised simulation libraries at a
+/// lower optimisation level ([`crate::compiler`]).
 pub fn linted_cargo() -> Result<Command> {
     let mut c = cargo();
     let wrapper =
