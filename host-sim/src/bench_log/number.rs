@@ -77,15 +77,15 @@ fn spell(buf: &mut zmij::Buffer, v: f64) -> Option<[&str; 2]> {
     Some([text, ""])
 }
 
-/// Whether zmij's `text` for `v` may be one of two equally near shortest decimals (which
-/// of the two a formatter takes is its own rule: zmij's and Rust's need not agree).
-/// Equally near n-digit decimals are neighbours (any between them would be nearer) and `v`
-/// is their midpoint: its exact decimal expansion has n + 1 significant digits. The exact value m·2^e (m odd) is an
-/// integer for e ≥ 0, never such a midpoint; for e < 0 it has −e fractional digits, so
-/// point − e significant ones (value = 0.d₁d₂… × 10^point). So a tie needs e < 0 and
-/// point − e = n + 1 ≤ 18. The decimal point's place is bounded from the binary exponent
-/// first (10^(point − 1) ≤ |v| < 2^(E + 1)), which rules out nearly every value before the
-/// text is read.
+/// Whether zmij's `text` for `v` may be one of two equally near shortest decimals (which of
+/// the two a formatter takes is its own rule: zmij's and Rust's need not agree). Equally
+/// near n-digit decimals are neighbours (any between them would be nearer) and `v` is their
+/// midpoint: its exact decimal expansion has n + 1 significant digits. The exact value
+/// m·2^e (m odd) is an integer for e ≥ 0, never such a midpoint; for e < 0 it has −e
+/// fractional digits, so point − e significant ones (value = 0.d₁d₂… × 10^point). So a tie
+/// needs e < 0 and point − e = n + 1 ≤ 18. The decimal point's place is bounded from the
+/// binary exponent first (10^(point − 1) ≤ |v| < 2^(E + 1)), which rules out nearly every
+/// value before the text is read.
 fn maybe_tie(v: f64, text: &[u8]) -> bool {
     let bits = v.to_bits();
     let raw_exp = ((bits >> 52) & 0x7ff) as i32;
