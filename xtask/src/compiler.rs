@@ -26,6 +26,10 @@ use std::process::Command;
 /// Environment variable holding the `clippy-driver` the wrapper hands its calls to.
 pub const DRIVER_VAR: &str = "EHA_XTASK_CLIPPY_DRIVER";
 
+/// Environment variable naming the wrapper (`cargo xtask`'s executable) for the processes
+/// `cargo xtask` starts that run linted builds themselves.
+pub const WRAPPER_VAR: &str = "EHA_XTASK_WRAPPER";
+
 /// Crates (rustc's names) whose unit-test build takes a lower optimisation level, and that
 /// level: 0 where the compile saves far more than the slower tests cost, 1 for the
 /// firmware's, whose tests would spend unoptimised about what the compile saves.

@@ -5,57 +5,52 @@
 //!    (rustup), the `flip-link` linker (cargo install), `qemu-system-arm` and `tmux`
 //!    (apt-get), Python's `cantools`, `dask` and `distributed` (a virtual environment);
 //! 2. `cargo fmt --check`; every target of the workspace built for the host with Clippy's
-//!    lints, warnings denied, in the same compilation ([`workspace::linted_cargo`]: what
+//!    lints, warnings denied, in the same compilation ([`linted_cargo`]: what
 //!    `cargo clippy --workspace --all-targets -- -D warnings` checks, without checking every
 //!    crate a second time), the unit tests of the optimised simulation libraries compiled
 //!    at a lower optimisation level ([`compiler`]);
 //! 3. the host tests of the whole workspace, and `eha fleet` against its Dask driver on a
-//!    local two-worker cluster and against its shards ([`fleet_check`]);
-//! 4. the CAN DBC file: in sync with `firmware::can_protocol` ([`dbc`]), and cantools
-//!    against the firmware's codec both ways ([`can_check`]);
+//!    local two-worker cluster and against its shards;
+//! 4. the CAN DBC file: in sync with `firmware::can_protocol`, and cantools
+//!    against the firmware's codec both ways;
 //! 5. the firmware for the STM32G474RE with warnings denied, and its flash and static-RAM
 //!    use against the budget (96 KiB / 16 KiB, so it also fits an STM32G431xB with the
 //!    parameter pages), written to `target/firmware-size.json`;
-//! 6. the processor-in-the-loop run in QEMU ([`pil`]): the control core and the plant on
+//! 6. the processor-in-the-loop run in QEMU: the control core and the plant on
 //!    the Cortex-M4F, telemetry through defmt and `eha ingest`, compared with the host run,
 //!    instruction counts against `pil/budget.toml`, the stack's high-water mark against the
 //!    firmware's stack (at least 4×), figures in `target/pil/report.json`;
-//!    the same telemetry piped into `eha watch` under tmux ([`watch_check`]): its screen
+//!    the same telemetry piped into `eha watch` under tmux: its screen
 //!    checked, its bench log equal to `eha ingest`'s.
 //!
 //! `cargo xtask fw-size` does step 5 alone, `cargo xtask pil` step 6, `cargo xtask can`
 //! step 4, `cargo xtask fleet` the fleet check of step 3; `cargo xtask dbc [--node N]
 //! [--out FILE]` writes the DBC file; `cargo xtask rooms` lists the files over 650 lines and
-//! the import circles between files ([`rooms`]).
+//! the import circles between files.
+//!
+//! This executable does steps 1–3's builds and test runs itself, with only `anyhow` to
+//! compile before it starts; the checks (the rooms, fleet, CAN, firmware and PIL steps) are
+//! the executable of `xtask/checks`, which the linted build of step 2 makes with the rest of
+//! the workspace ([`check`]). On their own, those commands build it with plain Cargo.
 
-mod can_check;
-mod compiler;
-mod dbc;
-mod firmware_image;
-mod fleet_check;
-mod pil;
-mod rooms;
-mod setup;
-mod watch_check;
-mod workspace;
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+use std::process::Command;
+use xtask::workspace::{cargo, debug_binary, linted_cargo, run};
+use xtask::{compiler, setup};
 
-use anyhow::Result;
-use firmware_image::{ensure_target, firmware};
-use workspace::{cargo, linted_cargo, root, run};
+/// The commands the checks' executable does, each on its own here.
+const CHECKS: [&str; 6] = ["fw-size", "pil", "can", "fleet", "rooms", "dbc"];
+
+/// The checks' executable (the package `xtask-checks`).
+const CHECKS_EXE: &str = "xtask-checks";
 
 fn main() {
     compiler::wrap_if_called();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("test") => test(),
-        Some("fw-size") => firmware().map(|_| ()),
-        Some("pil") => ensure_target()
-            .and_then(|()| setup::tools())
-            .and_then(|()| pil::pil()),
-        Some("dbc") => dbc::dbc(&args[1..]),
-        Some("rooms") => rooms::rooms(&args[1..]),
-        Some("can") => can(),
-        Some("fleet") => setup::python().and_then(|p| fleet_check::check(&p)),
+        Some(command) if CHECKS.contains(&command) => check_alone(&args),
         _ => {
             eprintln!(
                 "usage: cargo xtask <test | fw-size | pil | can | fleet | rooms [--root DIR] | dbc [--node N] [--out FILE]>"
@@ -69,17 +64,54 @@ fn main() {
     }
 }
 
-/// The DBC file in sync, then cantools against the firmware's codec.
-fn can() -> Result<()> {
-    let text = dbc::generate(dbc::DEFAULT_NODE)?;
-    dbc::check_in_sync(&text, &root().join(dbc::FILE))?;
-    can_check::check(&setup::python()?)
+/// One check on its own: the checks' executable built by plain Cargo (its dependencies'
+/// features resolved for it alone, as `cargo run` would) and run with `args`, exiting
+/// with its status.
+fn check_alone(args: &[String]) -> Result<()> {
+    run(
+        "the checks' executable",
+        cargo().args(["build", "--quiet", "--package", CHECKS_EXE]),
+    )?;
+    let status = checks_command(args, None)?
+        .status()
+        .with_context(|| format!("starting {}", debug_binary(CHECKS_EXE).display()))?;
+    std::process::exit(status.code().unwrap_or(1));
+}
+
+/// The checks' executable with `args`, told which wrapper the linted builds run (this
+/// executable, so the builds it starts reuse this one's) and, when known, the Python
+/// interpreter with the checks' packages.
+fn checks_command(args: &[String], python: Option<&Path>) -> Result<Command> {
+    let exe = debug_binary(CHECKS_EXE);
+    if !exe.is_file() {
+        bail!(
+            "{} is missing: the build before should have made it",
+            exe.display()
+        );
+    }
+    let mut cmd = Command::new(exe);
+    cmd.args(args).env(
+        compiler::WRAPPER_VAR,
+        std::env::current_exe().context("this task's executable, the compiler wrapper")?,
+    );
+    if let Some(python) = python {
+        cmd.env("EHA_PYTHON", python);
+    }
+    Ok(cmd)
+}
+
+/// Runs the check `command` of the checks' executable the linted build made.
+fn check(command: &str, python: Option<&Path>) -> Result<()> {
+    run(
+        command,
+        &mut checks_command(&[command.to_string()], python)?,
+    )
 }
 
 fn test() -> Result<()> {
     let mut times = StepTimes::default();
     times.step("setup", || {
-        ensure_target()?;
+        setup::ensure_target()?;
         setup::tools()
     })?;
     let python = times.step("python", setup::python)?;
@@ -87,7 +119,8 @@ fn test() -> Result<()> {
         run("format", cargo().args(["fmt", "--all", "--", "--check"]))
     })?;
     // Every target: what the test runs need (`--all-targets` would build the examples a
-    // second time, as tests), then the benchmarks.
+    // second time, as tests), with the checks' executable (its integration test needs
+    // it), then the benchmarks.
     times.step("lint, build", || {
         let step = "host build, Clippy's lints with warnings denied";
         run(
@@ -99,18 +132,14 @@ fn test() -> Result<()> {
             linted_cargo()?.args(["test", "--workspace", "--benches", "--no-run"]),
         )
     })?;
-    times.step("rooms", || rooms::rooms(&[]))?;
+    times.step("rooms", || check("rooms", None))?;
     times.step("host tests", || {
         run("host tests", linted_cargo()?.args(["test", "--workspace"]))
     })?;
-    times.step("fleet", || fleet_check::check(&python))?;
-    times.step("can", || {
-        let text = dbc::generate(dbc::DEFAULT_NODE)?;
-        dbc::check_in_sync(&text, &root().join(dbc::FILE))?;
-        can_check::check(&python)
-    })?;
-    times.step("firmware", || firmware().map(|_| ()))?;
-    times.step("pil", pil::pil)?;
+    times.step("fleet", || check("fleet", Some(&python)))?;
+    times.step("can", || check("can", Some(&python)))?;
+    times.step("firmware", || check("fw-size", None))?;
+    times.step("pil", || check("pil", None))?;
     eprintln!("\nxtask: step times\n{times}");
     eprintln!("\nxtask: all checks passed");
     Ok(())

@@ -1,6 +1,7 @@
 //! What `cargo xtask test` needs beyond Rust, installed when missing so the README's one
 //! command works on a fresh machine (Debian or Ubuntu, as root or with sudo-less apt):
 //!
+//! - the Cortex-M4F target [`TARGET`] of the firmware and the PIL image, with rustup;
 //! - `flip-link`, the linker of the Cortex-M images (`.cargo/config.toml`), with
 //!   `cargo install --locked` at the version [`FLIP_LINK_VERSION`];
 //! - `qemu-system-arm` (QEMU's Cortex-M4F, `mps2-an386`) for the processor-in-the-loop run;
@@ -71,6 +72,29 @@ pub fn linker() -> Result<()> {
                 "--version",
                 FLIP_LINK_VERSION,
             ]),
+        )?;
+    }
+    Ok(())
+}
+
+/// The firmware's and the PIL's target.
+pub const TARGET: &str = "thumbv7em-none-eabihf";
+/// The Cortex-M4F target and the linker its images use (flip-link).
+pub fn ensure_target() -> Result<()> {
+    linker()?;
+    let out = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .context(
+            "rustup is needed to install the thumbv7em-none-eabihf target (https://rustup.rs)",
+        )?;
+    if !String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .any(|l| l.trim() == TARGET)
+    {
+        crate::workspace::run(
+            "install the Cortex-M4F target",
+            Command::new("rustup").args(["target", "add", TARGET]),
         )?;
     }
     Ok(())

@@ -1,6 +1,7 @@
 //! The workspace the tasks run in: its root, Cargo's target directory, a `cargo` command
-//! started at the root (plain, or linting the workspace's crates as it builds them), and the
-//! runner of one step that names the step when it fails.
+//! started at the root (plain, or linting the workspace's crates as it builds them), the
+//! runner of one step that names the step when it fails, and the executables the linted
+//! build makes that the tasks run (`eha`, the checks).
 
 use crate::compiler;
 use anyhow::{bail, Context, Result};
@@ -37,13 +38,17 @@ const CLIPPY_ARGS: &str = "-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__";
 /// fingerprints the wrapper: a plain `cargo test` in the same target directory compiles the
 /// workspace's crates again (not their dependencies), and so do the tasks after it.
 ///
-/// Cargo runs this task's own executable as the wrapper, which hands each call to
+/// Cargo runs `cargo xtask`'s own executable as the wrapper, which hands each call to
 /// `clippy-driver` and compiles the unit tests of the optimised simulation libraries at a
-/// lower optimisation level ([`crate::compiler`]).
+/// lower optimisation level ([`crate::compiler`]): this process's, or the one
+/// [`compiler::WRAPPER_VAR`] names when `cargo xtask` started this process (the checks'
+/// executable), so every linted build has the same wrapper and none rebuilds another's.
 pub fn linted_cargo() -> Result<Command> {
     let mut c = cargo();
-    let wrapper =
-        std::env::current_exe().context("this task's executable, the compiler wrapper")?;
+    let wrapper = match std::env::var_os(compiler::WRAPPER_VAR) {
+        Some(path) => PathBuf::from(path),
+        None => std::env::current_exe().context("this task's executable, the compiler wrapper")?,
+    };
     c.env("RUSTC_WORKSPACE_WRAPPER", wrapper)
         .env(compiler::DRIVER_VAR, clippy_driver()?)
         .env("CLIPPY_ARGS", CLIPPY_ARGS);
@@ -102,5 +107,13 @@ pub fn eha_binary(step: &str) -> Result<PathBuf> {
         step,
         linted_cargo()?.args(["test", "--workspace", "--no-run"]),
     )?;
-    Ok(target_dir().join("debug").join("eha"))
+    Ok(debug_binary("eha"))
+}
+
+/// The executable `name` of the workspace's dev build (`target/debug/NAME`): what the last
+/// build that made it left there.
+pub fn debug_binary(name: &str) -> PathBuf {
+    target_dir()
+        .join("debug")
+        .join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
 }

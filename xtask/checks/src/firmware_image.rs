@@ -1,17 +1,13 @@
 //! Step 5 of `cargo xtask test` (and `cargo xtask fw-size`): the firmware for the
 //! STM32G474RE built with warnings denied, and its flash and static-RAM use, read from the
-//! ELF's sections, against the budget (written to `target/firmware-size.json`); the
-//! Cortex-M4F target and the linker its images need.
+//! ELF's sections, against the budget (written to `target/firmware-size.json`).
 
-use crate::setup;
-use crate::workspace::{cargo, run, target_dir};
 use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 use std::path::Path;
-use std::process::Command;
+use xtask::setup::{ensure_target, TARGET};
+use xtask::workspace::{cargo, run, target_dir};
 
-/// The firmware's and the PIL's target.
-pub const TARGET: &str = "thumbv7em-none-eabihf";
 /// 96 KiB: an STM32G431xB (128 KiB) still holds the image and the parameter store's pages.
 pub const FLASH_BUDGET: u64 = 96 * 1024;
 /// Static RAM the firmware may use.
@@ -19,27 +15,6 @@ pub const RAM_BUDGET: u64 = 16 * 1024;
 /// The STM32G474RE's RAM as `memory.x` describes it. With flip-link the stack has all of
 /// it below the statics: at least this less [`RAM_BUDGET`].
 pub const FIRMWARE_RAM: u64 = 128 * 1024;
-
-/// The Cortex-M4F target and the linker its images use (flip-link).
-pub fn ensure_target() -> Result<()> {
-    setup::linker()?;
-    let out = Command::new("rustup")
-        .args(["target", "list", "--installed"])
-        .output()
-        .context(
-            "rustup is needed to install the thumbv7em-none-eabihf target (https://rustup.rs)",
-        )?;
-    if !String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .any(|l| l.trim() == TARGET)
-    {
-        run(
-            "install the Cortex-M4F target",
-            Command::new("rustup").args(["target", "add", TARGET]),
-        )?;
-    }
-    Ok(())
-}
 
 /// Builds the firmware image with warnings denied and checks its size.
 pub fn firmware() -> Result<(u64, u64)> {

@@ -43,9 +43,9 @@ pub fn pil() -> Result<()> {
              `apt-get update` first on a fresh machine)"
         );
     }
-    crate::workspace::run(
+    xtask::workspace::run(
         "PIL image (warnings denied)",
-        crate::workspace::cargo().args([
+        xtask::workspace::cargo().args([
             "build",
             "--release",
             "--package",
@@ -53,17 +53,17 @@ pub fn pil() -> Result<()> {
             "--bin",
             "pil",
             "--target",
-            crate::firmware_image::TARGET,
+            xtask::setup::TARGET,
             "--config",
             &format!(
                 "target.{}.rustflags=[\"-D\", \"warnings\"]",
-                crate::firmware_image::TARGET
+                xtask::setup::TARGET
             ),
         ]),
     )?;
-    let target_dir = crate::workspace::target_dir();
+    let target_dir = xtask::workspace::target_dir();
     let elf = target_dir
-        .join(crate::firmware_image::TARGET)
+        .join(xtask::setup::TARGET)
         .join("release")
         .join("pil");
     let out_dir = target_dir.join("pil");
@@ -87,10 +87,10 @@ pub fn pil() -> Result<()> {
         );
     }
 
-    let eha_bin = crate::workspace::eha_binary("eha for the PIL comparison")?;
+    let eha_bin = xtask::workspace::eha_binary("eha for the PIL comparison")?;
     let pil_csv = out_dir.join("pil.csv");
     let host_csv = out_dir.join("host.csv");
-    crate::workspace::run(
+    xtask::workspace::run(
         "eha ingest (PIL telemetry)",
         eha(&eha_bin).args([
             "ingest",
@@ -100,7 +100,7 @@ pub fn pil() -> Result<()> {
         ]),
     )?;
     crate::watch_check::check(&eha_bin, &defmt_log, &pil_csv, &out_dir)?;
-    crate::workspace::run(
+    xtask::workspace::run(
         "eha simulate (same scenario on the host)",
         eha(&eha_bin).args([
             "simulate",
@@ -202,8 +202,8 @@ pub fn pil() -> Result<()> {
 /// it), when the image has been built. [bytes]
 fn firmware_stack_bytes() -> Option<u64> {
     use object::{Object, ObjectSymbol};
-    let elf = crate::workspace::target_dir()
-        .join(crate::firmware_image::TARGET)
+    let elf = xtask::workspace::target_dir()
+        .join(xtask::setup::TARGET)
         .join("release")
         .join("firmware");
     let data = fs::read(elf).ok()?;
@@ -216,7 +216,7 @@ fn firmware_stack_bytes() -> Option<u64> {
     symbol("_stack_start")?.checked_sub(symbol("_stack_end")?)
 }
 
-/// `eha` from the workspace, as the host tests build it ([`crate::workspace::eha_binary`]).
+/// `eha` from the workspace, as the host tests build it ([`xtask::workspace::eha_binary`]).
 fn eha(bin: &Path) -> Command {
     Command::new(bin)
 }
@@ -343,7 +343,7 @@ fn figure(figures: &BTreeMap<String, f64>, key: &str) -> Result<f64> {
 
 /// The recorded current-loop budget and the goal, from `pil/budget.toml`. [instructions]
 fn budget() -> Result<(f64, f64)> {
-    let path = crate::workspace::root().join("pil").join("budget.toml");
+    let path = xtask::workspace::root().join("pil").join("budget.toml");
     let text = fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let table: toml::Table = text
         .parse()

@@ -10,7 +10,7 @@
 //!    afresh): their tables concatenated must be the table of step 1.
 //!
 //! The Python side runs with the interpreter of the virtual environment `.ci/run` and
-//! [`crate::setup`] make, with `dask` and `distributed` from `xtask/requirements.txt`
+//! [`xtask::setup`] make, with `dask` and `distributed` from `xtask/requirements.txt`
 //! (missing is a failure, never a skip).
 
 use anyhow::{bail, Context, Result};
@@ -97,9 +97,9 @@ fn json_rows(path: &Path) -> Result<Vec<Value>> {
 
 /// Runs the check with the Python interpreter `python`.
 pub fn check(python: &Path) -> Result<()> {
-    let root = crate::workspace::root();
-    let eha = crate::workspace::eha_binary("eha for the fleet check")?;
-    let base = crate::workspace::target_dir().join("fleet-check");
+    let root = xtask::workspace::root();
+    let eha = xtask::workspace::eha_binary("eha for the fleet check")?;
+    let base = xtask::workspace::target_dir().join("fleet-check");
     let _ = fs::remove_dir_all(&base);
     let logs = base.join("logs");
     fs::create_dir_all(&logs)?;

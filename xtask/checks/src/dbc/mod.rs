@@ -42,7 +42,7 @@ pub const FILE: &str = "eha.dbc";
 /// `cargo xtask dbc [--node N] [--out FILE] [--check]`.
 pub fn dbc(args: &[String]) -> Result<()> {
     let mut node = DEFAULT_NODE;
-    let mut out = crate::workspace::root().join(FILE);
+    let mut out = xtask::workspace::root().join(FILE);
     let mut check = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {

@@ -10,7 +10,7 @@
 //!    README's command, names the message and its values.
 //!
 //! The Python side is `xtask/can_check.py`, run with the interpreter of the virtual
-//! environment `.ci/run` and [`crate::setup`] make (`cantools` missing is a failure).
+//! environment `.ci/run` and [`xtask::setup`] make (`cantools` missing is a failure).
 
 use crate::dbc::{parameter_signal, DEFAULT_NODE};
 use anyhow::{bail, Context, Result};
@@ -399,17 +399,17 @@ pub fn check(python: &std::path::Path) -> Result<()> {
             })
         })
         .collect();
-    let dir = crate::workspace::target_dir().join("can-check");
+    let dir = xtask::workspace::target_dir().join("can-check");
     std::fs::create_dir_all(&dir)?;
     let input = dir.join("firmware-frames.json");
     let output = dir.join("cantools-frames.json");
     std::fs::write(&input, serde_json::to_string_pretty(&vectors)?)?;
     let _ = std::fs::remove_file(&output);
-    crate::workspace::run(
+    xtask::workspace::run(
         "CAN: cantools against the firmware's codec",
         Command::new(python)
-            .arg(crate::workspace::root().join("xtask").join("can_check.py"))
-            .arg(crate::workspace::root().join(crate::dbc::FILE))
+            .arg(xtask::workspace::root().join("xtask").join("can_check.py"))
+            .arg(xtask::workspace::root().join(crate::dbc::FILE))
             .arg(&input)
             .arg(&output),
     )?;

@@ -1,0 +1,12 @@
+//! What `cargo xtask` and its checks' executable (`xtask/checks`) share: the workspace and
+//! its linted `cargo` ([`workspace`]), the compiler wrapper that linted build runs
+//! ([`compiler`]), and the tools the checks need installed when missing ([`setup`]).
+//!
+//! It depends on `anyhow` alone, so `cargo xtask` builds in seconds on a fresh clone; the
+//! checks with their heavier dependencies (the firmware's codec, the ELF and defmt readers,
+//! the Rust parser) are a workspace member, compiled by the linted build with the features
+//! the rest of the workspace resolves, so no dependency is compiled twice.
+
+pub mod compiler;
+pub mod setup;
+pub mod workspace;
