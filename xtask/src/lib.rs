@@ -1,6 +1,7 @@
 //! What `cargo xtask` and its checks' executable (`xtask/checks`) share: the workspace and
 //! its linted `cargo` ([`workspace`]), the compiler wrapper that linted build runs
-//! ([`compiler`]), and the tools the checks need installed when missing ([`setup`]).
+//! ([`compiler`]), the tools the checks need installed when missing ([`setup`]), and the
+//! builds of the Cortex-M4F images ([`images`]).
 //!
 //! It depends on `anyhow` alone, so `cargo xtask` builds in seconds on a fresh clone; the
 //! checks with their heavier dependencies (the firmware's codec, the ELF and defmt readers,
@@ -8,5 +9,6 @@
 //! the rest of the workspace resolves, so no dependency is compiled twice.
 
 pub mod compiler;
+pub mod images;
 pub mod setup;
 pub mod workspace;

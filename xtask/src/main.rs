@@ -31,13 +31,14 @@
 //! This executable does steps 1–3's builds and test runs itself, with only `anyhow` to
 //! compile before it starts; the checks (the rooms, fleet, CAN, firmware and PIL steps) are
 //! the executable of `xtask/checks`, which the linted build of step 2 makes with the rest of
-//! the workspace ([`check`]). On their own, those commands build it with plain Cargo.
+//! the workspace ([`check`]). On their own, those commands build it with plain Cargo. The
+//! Cortex-M4F images of steps 5 and 6 are built while the host tests run ([`images`]).
 
 use anyhow::{bail, Context, Result};
 use std::path::Path;
 use std::process::Command;
 use xtask::workspace::{cargo, debug_binary, linted_cargo, run};
-use xtask::{compiler, setup};
+use xtask::{compiler, images, setup};
 
 /// The commands the checks' executable does, each on its own here.
 const CHECKS: [&str; 6] = ["fw-size", "pil", "can", "fleet", "rooms", "dbc"];
@@ -133,11 +134,16 @@ fn test() -> Result<()> {
         )
     })?;
     times.step("rooms", || check("rooms", None))?;
+    let images = images::ahead()?;
     times.step("host tests", || {
         run("host tests", linted_cargo()?.args(["test", "--workspace"]))
     })?;
     times.step("fleet", || check("fleet", Some(&python)))?;
     times.step("can", || check("can", Some(&python)))?;
+    times.step("images", || {
+        images.join();
+        Ok(())
+    })?;
     times.step("firmware", || check("fw-size", None))?;
     times.step("pil", || check("pil", None))?;
     eprintln!("\nxtask: step times\n{times}");

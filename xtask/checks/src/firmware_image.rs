@@ -6,7 +6,7 @@ use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 use std::path::Path;
 use xtask::setup::{ensure_target, TARGET};
-use xtask::workspace::{cargo, run, target_dir};
+use xtask::workspace::target_dir;
 
 /// 96 KiB: an STM32G431xB (128 KiB) still holds the image and the parameter store's pages.
 pub const FLASH_BUDGET: u64 = 96 * 1024;
@@ -19,21 +19,7 @@ pub const FIRMWARE_RAM: u64 = 128 * 1024;
 /// Builds the firmware image with warnings denied and checks its size.
 pub fn firmware() -> Result<(u64, u64)> {
     ensure_target()?;
-    run(
-        "firmware (warnings denied)",
-        cargo().args([
-            "build",
-            "--release",
-            "--package",
-            "firmware",
-            "--bin",
-            "firmware",
-            "--target",
-            TARGET,
-            "--config",
-            &format!("target.{TARGET}.rustflags=[\"-D\", \"warnings\"]"),
-        ]),
-    )?;
+    xtask::images::build("firmware (warnings denied)", "firmware")?;
     let target_dir = target_dir();
     let elf = target_dir.join(TARGET).join("release").join("firmware");
     let (flash, ram) = image_size(&elf)?;

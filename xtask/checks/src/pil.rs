@@ -43,24 +43,8 @@ pub fn pil() -> Result<()> {
              `apt-get update` first on a fresh machine)"
         );
     }
-    xtask::workspace::run(
-        "PIL image (warnings denied)",
-        xtask::workspace::cargo().args([
-            "build",
-            "--release",
-            "--package",
-            "pil",
-            "--bin",
-            "pil",
-            "--target",
-            xtask::setup::TARGET,
-            "--config",
-            &format!(
-                "target.{}.rustflags=[\"-D\", \"warnings\"]",
-                xtask::setup::TARGET
-            ),
-        ]),
-    )?;
+    xtask::images::build("PIL image (warnings denied)", "pil")?;
+
     let target_dir = xtask::workspace::target_dir();
     let elf = target_dir
         .join(xtask::setup::TARGET)
