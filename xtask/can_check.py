@@ -1,4 +1,4 @@
-"""The cantools side of `cargo xtask test`'s CAN check (xtask/src/can_check.rs).
+"""The cantools side of `cargo xtask test`'s CAN check (xtask/checks/src/can_check.rs).
 
 usage: can_check.py EHA.DBC FIRMWARE_FRAMES.JSON CANTOOLS_FRAMES.JSON
 
