@@ -12,7 +12,7 @@
 //! The Python side is `xtask/can_check.py`, run with the interpreter of the virtual
 //! environment `.ci/run` and [`xtask::setup`] make (`cantools` missing is a failure).
 
-use crate::dbc::{parameter_signal, DEFAULT_NODE};
+use crate::dbc::{parameter_signal, words, DEFAULT_NODE};
 use anyhow::{bail, Context, Result};
 use firmware::can_protocol::{
     decode_command, decode_reply, encode_command, encode_reply, Diagnostics, Frame, Function,
@@ -218,17 +218,6 @@ fn expected_reply(r: &Reply) -> Expected {
             1.0,
         ),
     }
-}
-
-fn words(debug_name: &str) -> String {
-    let mut out = String::new();
-    for (k, c) in debug_name.chars().enumerate() {
-        if c.is_uppercase() && k > 0 {
-            out.push(' ');
-        }
-        out.extend(c.to_lowercase());
-    }
-    out
 }
 
 /// Every frame kind, with every code of every value table.

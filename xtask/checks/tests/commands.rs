@@ -1,6 +1,6 @@
 //! The checks' executable as `cargo xtask` runs it: an unknown command is a usage error
-//! (exit 2), `dbc --out` writes what the checked-in `eha.dbc` holds for the default node,
-//! and `rooms --root` fails on a checkout with a file over the line limit, naming it.
+//! (exit 2), `dbc --node N --out` addresses every message to node N and refuses a node the
+//! protocol has not, and `rooms --root` fails on a checkout with a file over the line limit, naming it.
 //!
 //! Cargo builds the executable for these tests, so the workspace's linted test build makes
 //! it with the features the whole workspace resolves (what `cargo xtask test` runs).
@@ -22,15 +22,45 @@ fn an_unknown_command_is_a_usage_error() {
     assert!(String::from_utf8_lossy(&out.stderr).starts_with("usage: xtask-checks"));
 }
 
-#[test]
-fn dbc_writes_the_checked_in_file() {
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("eha.dbc");
-    let out = checks(&["dbc", "--out", file.to_str().unwrap()]);
+/// The messages of a DBC file: (CAN id, name) of each `BO_` line.
+fn messages(dbc: &str) -> Vec<(u32, String)> {
+    dbc.lines()
+        .filter_map(|l| l.strip_prefix("BO_ "))
+        .map(|l| {
+            let mut words = l.split_whitespace();
+            let id = words.next().unwrap().parse().unwrap();
+            (id, words.next().unwrap().trim_end_matches(':').to_string())
+        })
+        .collect()
+}
+
+/// Writes the DBC file for `node` with `dbc --node N --out FILE` and reads it back.
+fn dbc_for(node: &str, dir: &Path) -> String {
+    let file = dir.join(format!("node-{node}.dbc"));
+    let out = checks(&["dbc", "--node", node, "--out", file.to_str().unwrap()]);
     assert!(out.status.success(), "{out:?}");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let checked_in = std::fs::read_to_string(root.join("eha.dbc")).unwrap();
-    assert_eq!(std::fs::read_to_string(&file).unwrap(), checked_in);
+    std::fs::read_to_string(&file).unwrap()
+}
+
+#[test]
+fn dbc_addresses_each_message_to_the_node() {
+    // The protocol's addressing: a message's CAN id is its base plus the node (0..=15), so
+    // node 3's file has the same messages as node 1's, each id higher by two.
+    let dir = tempfile::tempdir().unwrap();
+    let one = messages(&dbc_for("1", dir.path()));
+    let three = messages(&dbc_for("3", dir.path()));
+    assert!(one.len() >= 10, "{one:?}");
+    assert_eq!(one.len(), three.len());
+    for ((id1, name1), (id3, name3)) in one.iter().zip(&three) {
+        assert_eq!(name1, name3);
+        assert_eq!(id3 - id1, 2, "{name1}");
+    }
+    // A node the protocol has not is refused, and nothing is written.
+    let file = dir.path().join("node-16.dbc");
+    let out = checks(&["dbc", "--node", "16", "--out", file.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("node 16"));
+    assert!(!file.exists());
 }
 
 #[test]

@@ -30,7 +30,7 @@ mod values;
 pub use render::{generate, messages};
 pub use replies::ReplyKind;
 pub use signal::{ascii, shortest};
-pub use values::parameter_signal;
+pub use values::{parameter_signal, words};
 
 use anyhow::{bail, Result};
 

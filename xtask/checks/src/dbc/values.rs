@@ -10,7 +10,7 @@ use firmware::step_test::StepLoop;
 use firmware::{FaultCode, Mode};
 
 /// "BelowMinimum" → "below minimum".
-pub(super) fn words(debug_name: &str) -> String {
+pub fn words(debug_name: &str) -> String {
     let mut out = String::new();
     for (k, c) in debug_name.chars().enumerate() {
         if c.is_uppercase() && k > 0 {
