@@ -9,7 +9,7 @@
 //! sampled, so the run reports how much memory a worker took.
 
 use super::cache::Outcome;
-use crate::output::interrupt;
+use crate::output::{interrupt, paths};
 use serde_json::Value;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -124,7 +124,12 @@ impl Runner {
             .stdout(Stdio::null())
             .stderr(Stdio::piped());
         let finished = match cmd.spawn() {
-            Ok(child) => self.watch(child, log, &json),
+            Ok(child) => {
+                let pid = child.id();
+                let finished = self.watch(child, log, &json);
+                remove_left_behind(&json, pid);
+                finished
+            }
             Err(e) => Finished {
                 ran: Ran::Failed(format!(
                     "could not start `{} diagnose` for `{}`: {e}",
@@ -190,6 +195,28 @@ impl Runner {
         Finished {
             ran,
             peak_rss_bytes: peak,
+        }
+    }
+}
+
+/// Removes what the child `pid`, killed while it checked or wrote `json`, left beside
+/// it: its probe of the folder and its staged copies `.NAME.*.eha-tmp` (a killed process
+/// cannot remove them itself, [`interrupt`]). The JSON's name holds this process's id and
+/// a counter, so nothing else matches.
+fn remove_left_behind(json: &Path, pid: u32) {
+    let (Some(dir), Some(name)) = (json.parent(), json.file_name()) else {
+        return;
+    };
+    let _ = std::fs::remove_file(paths::probe_path(dir, pid));
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let n = entry.file_name();
+        let n = n.to_string_lossy();
+        if n.starts_with(&prefix) && n.ends_with(".eha-tmp") {
+            let _ = std::fs::remove_file(entry.path());
         }
     }
 }
@@ -306,5 +333,38 @@ mod tests {
     fn own_peak_memory_is_read() {
         let peak = own_peak_rss().unwrap();
         assert!(peak > 100 * 1024, "{peak}");
+    }
+
+    #[test]
+    fn a_killed_childs_probe_and_staged_copies_go_and_nothing_else() {
+        let dir = tempfile::tempdir().unwrap();
+        let json = dir.path().join(".run-7-3.json");
+        let names = [
+            ".eha-probe-41",
+            ".eha-probe-42",
+            "..run-7-3.json.Ab12Cd.eha-tmp",
+            "..run-7-3.json.Zz99Yy.eha-tmp",
+            "..run-7-31.json.Ab12Cd.eha-tmp",
+            "..run-7-3.json.Ab12Cd.eha-staging",
+            "x.json",
+        ];
+        for n in names {
+            std::fs::write(dir.path().join(n), "{").unwrap();
+        }
+        remove_left_behind(&json, 42);
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(
+            left,
+            [
+                "..run-7-3.json.Ab12Cd.eha-staging",
+                "..run-7-31.json.Ab12Cd.eha-tmp",
+                ".eha-probe-41",
+                "x.json"
+            ]
+        );
     }
 }

@@ -294,6 +294,12 @@ fn parent_of(path: &Path) -> &Path {
         .unwrap_or(Path::new("."))
 }
 
+/// The probe file process `pid` creates in `folder` ([`writable_folder`]) and removes
+/// at once; only a process killed between the two leaves it.
+pub fn probe_path(folder: &Path, pid: u32) -> PathBuf {
+    folder.join(format!(".eha-probe-{pid}"))
+}
+
 /// Creates and removes a probe file in `folder`: the one honest test that files can be
 /// created there (permissions, read-only file systems, a full quota, running as root).
 fn writable_folder(flag: &str, path: &Path, folder: &Path) -> Result<(), CliError> {
@@ -315,7 +321,7 @@ fn writable_folder(flag: &str, path: &Path, folder: &Path) -> Result<(), CliErro
         }
         Err(e) => return Err(bad(flag, path, describe(&e))),
     }
-    let probe = folder.join(format!(".eha-probe-{}", std::process::id()));
+    let probe = probe_path(folder, std::process::id());
     match OpenOptions::new().write(true).create_new(true).open(&probe) {
         Ok(_) => {
             let _ = fs::remove_file(&probe);
