@@ -3,7 +3,8 @@
 //!
 //! 1. what it needs installed when missing ([`setup`]): the `thumbv7em-none-eabihf` target
 //!    (rustup), the `flip-link` linker (cargo install), `qemu-system-arm` and `tmux`
-//!    (apt-get), Python's `cantools`, `dask` and `distributed` (a virtual environment);
+//!    (apt-get), Python's `cantools`, `dask` and `distributed` (a virtual environment),
+//!    installed in a child process beside step 2's build ([`setup::beside`]);
 //! 2. `cargo fmt --check`; every target of the workspace built for the host with Clippy's
 //!    lints, warnings denied, in the same compilation ([`linted_cargo`]: what
 //!    `cargo clippy --workspace --all-targets -- -D warnings` checks, without checking every
@@ -23,10 +24,10 @@
 //!    the same telemetry piped into `eha watch` under tmux: its screen
 //!    checked, its bench log equal to `eha ingest`'s.
 //!
-//! `cargo xtask fw-size` does step 5 alone, `cargo xtask pil` step 6, `cargo xtask can`
-//! step 4, `cargo xtask fleet` the fleet check of step 3; `cargo xtask dbc [--node N]
-//! [--out FILE]` writes the DBC file; `cargo xtask rooms` lists the files over 650 lines and
-//! the import circles between files.
+//! `cargo xtask setup` does step 1 alone, `cargo xtask fw-size` step 5, `cargo xtask pil`
+//! step 6, `cargo xtask can` step 4, `cargo xtask fleet` the fleet check of step 3; `cargo
+//! xtask dbc [--node N] [--out FILE]` writes the DBC file; `cargo xtask rooms` lists the
+//! files over 650 lines and the import circles between files.
 //!
 //! This executable does steps 1–3's builds and test runs itself, with only `anyhow` to
 //! compile before it starts; the checks (the rooms, fleet, CAN, firmware and PIL steps) are
@@ -51,10 +52,11 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let result = match args.first().map(String::as_str) {
         Some("test") => test(),
+        Some("setup") => setup::everything(),
         Some(command) if CHECKS.contains(&command) => check_alone(&args),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test | fw-size | pil | can | fleet | rooms [--root DIR] | dbc [--node N] [--out FILE]>"
+                "usage: cargo xtask <test | setup | fw-size | pil | can | fleet | rooms [--root DIR] | dbc [--node N] [--out FILE]>"
             );
             std::process::exit(2);
         }
@@ -111,11 +113,7 @@ fn check(command: &str, python: Option<&Path>) -> Result<()> {
 
 fn test() -> Result<()> {
     let mut times = StepTimes::default();
-    times.step("setup", || {
-        setup::ensure_target()?;
-        setup::tools()
-    })?;
-    let python = times.step("python", setup::python)?;
+    let installing = setup::beside()?;
     times.step("format", || {
         run("format", cargo().args(["fmt", "--all", "--", "--check"]))
     })?;
@@ -133,6 +131,9 @@ fn test() -> Result<()> {
             linted_cargo()?.args(["test", "--workspace", "--benches", "--no-run"]),
         )
     })?;
+    // The host tests need tmux, the images the target and flip-link.
+    times.step("setup", || installing.join())?;
+    let python = times.step("python", setup::python)?;
     times.step("rooms", || check("rooms", None))?;
     let images = images::ahead()?;
     times.step("host tests", || {

@@ -12,10 +12,14 @@
 //!   a missing or broken one is an error, never a skip.
 //!
 //! apt-get runs only when something is missing, after `apt-get update`.
+//!
+//! `cargo xtask test` runs it all ([`everything`]) in a child process beside the linted
+//! host build ([`beside`]), which needs none of it: on a fresh machine its time is mostly
+//! waiting on the network and the package manager, which the build's compilations fill.
 
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 
 /// Tools found on `PATH` by name, the argument that makes each print its version and exit
 /// successfully (QEMU refuses tmux's `-V`), and the Debian package that has each.
@@ -46,6 +50,7 @@ fn apt_install(packages: &[&str]) -> Result<()> {
     crate::workspace::run(
         "apt-get install",
         Command::new("apt-get")
+            .env("DEBIAN_FRONTEND", "noninteractive")
             .args(["install", "-y", "--no-install-recommends"])
             .args(packages),
     )
@@ -173,4 +178,68 @@ pub fn python() -> Result<PathBuf> {
         bail!("{} cannot `{IMPORTS}` after pip install", python.display());
     }
     Ok(python)
+}
+
+/// Everything above: the target, the linker, the tools, the Python environment (`cargo
+/// xtask setup`).
+pub fn everything() -> Result<()> {
+    ensure_target()?;
+    tools()?;
+    python().map(|_| ())
+}
+
+/// The setup running in a child process (`cargo xtask setup`, this executable), its output
+/// going to a file.
+pub struct Beside {
+    child: Option<Child>,
+    log: PathBuf,
+}
+
+/// Starts [`everything`] in a child process, its output written to `target/setup.log`.
+pub fn beside() -> Result<Beside> {
+    let log = crate::workspace::target_dir().join("setup.log");
+    std::fs::create_dir_all(crate::workspace::target_dir())?;
+    let file =
+        std::fs::File::create(&log).with_context(|| format!("creating {}", log.display()))?;
+    let exe = std::env::current_exe().context("this task's executable, for its setup")?;
+    let child = Command::new(exe)
+        .arg("setup")
+        .stdin(Stdio::null())
+        .stdout(file.try_clone()?)
+        .stderr(file)
+        .spawn()
+        .context("could not start the setup beside the build")?;
+    Ok(Beside {
+        child: Some(child),
+        log,
+    })
+}
+
+impl Beside {
+    /// Waits for the setup, shows its output and fails when it did.
+    pub fn join(mut self) -> Result<()> {
+        let status = match self.child.take() {
+            Some(mut child) => child.wait().context("waiting for the setup")?,
+            None => return Ok(()),
+        };
+        eprintln!("\n=== setup, run beside the build:");
+        match std::fs::read_to_string(&self.log) {
+            Ok(text) => eprint!("{text}"),
+            Err(e) => eprintln!("({}: {e})", self.log.display()),
+        }
+        if !status.success() {
+            bail!("setup failed ({status}; its output above)");
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Beside {
+    /// A step before failed: the setup is waited for, not killed (apt-get and dpkg must
+    /// not be cut off halfway).
+    fn drop(&mut self) {
+        if let Some(mut child) = self.child.take() {
+            let _ = child.wait();
+        }
+    }
 }
