@@ -8,11 +8,11 @@
 //! long single-threaded tests, the images' serial link). Their output is kept and shown
 //! when they are joined; the checks then build them again, which finds them fresh.
 
+use crate::beside::{self, Beside, Unjoined};
 use crate::setup::TARGET;
-use crate::workspace::{cargo, run, target_dir};
-use anyhow::{Context, Result};
-use std::path::PathBuf;
-use std::process::{Child, Command};
+use crate::workspace::{cargo, run};
+use anyhow::Result;
+use std::process::Command;
 
 /// The images, each a package with a binary of the same name.
 pub const IMAGES: [&str; 2] = ["firmware", "pil"];
@@ -31,67 +31,26 @@ pub fn build(step: &str, package: &str) -> Result<()> {
     run(step, &mut build_command(package))
 }
 
-/// The images' builds started ahead, their processes and the file their output goes to.
-/// Dropped before [`Ahead::join`] (a step before failed), it stops them.
-pub struct Ahead {
-    builds: Vec<Child>,
-    log: PathBuf,
+/// Starts building every image of [`IMAGES`] ([`beside`], output in
+/// `target/images-ahead.log`). Cargo's lock on the target's build directory runs them one
+/// after the other; dropped unjoined (a step before failed), they are stopped.
+pub fn ahead() -> Result<Beside> {
+    beside::start(
+        "the Cortex-M4F images, built beside the host tests",
+        "images-ahead.log",
+        IMAGES.map(build_command),
+        Unjoined::Kill,
+    )
 }
 
-/// Starts building every image of [`IMAGES`], their output written to
-/// `target/images-ahead.log`. Cargo's lock on the target's build directory runs them one
-/// after the other.
-pub fn ahead() -> Result<Ahead> {
-    let log = target_dir().join("images-ahead.log");
-    std::fs::create_dir_all(target_dir())?;
-    let file =
-        std::fs::File::create(&log).with_context(|| format!("creating {}", log.display()))?;
-    let mut ahead = Ahead {
-        builds: Vec::new(),
-        log,
-    };
-    for package in IMAGES {
-        let mut cmd = build_command(package);
-        cmd.stdout(file.try_clone()?).stderr(file.try_clone()?);
-        let child = cmd
-            .spawn()
-            .with_context(|| format!("could not start {cmd:?}"))?;
-        ahead.builds.push(child);
-    }
-    Ok(ahead)
-}
-
-impl Ahead {
-    /// Waits for the builds and shows their output. A failed build is reported, not
-    /// returned: the check that builds the image again fails with the compiler's message.
-    pub fn join(mut self) {
-        let mut failed = Vec::new();
-        for mut child in std::mem::take(&mut self.builds) {
-            match child.wait() {
-                Ok(status) if status.success() => {}
-                Ok(status) => failed.push(status.to_string()),
-                Err(e) => failed.push(e.to_string()),
-            }
-        }
-        eprintln!("\n=== the Cortex-M4F images, built beside the host tests:");
-        match std::fs::read_to_string(&self.log) {
-            Ok(text) => eprint!("{text}"),
-            Err(e) => eprintln!("({}: {e})", self.log.display()),
-        }
-        if !failed.is_empty() {
-            eprintln!(
-                "xtask: building the images ahead failed ({}); their checks build them again",
-                failed.join(", ")
-            );
-        }
-    }
-}
-
-impl Drop for Ahead {
-    fn drop(&mut self) {
-        for child in &mut self.builds {
-            let _ = child.kill();
-            let _ = child.wait();
-        }
+/// Waits for the images' builds and shows their output. A failed build is reported, not
+/// returned: the check that builds the image again fails with the compiler's message.
+pub fn join(ahead: Beside) {
+    let failed = ahead.join();
+    if !failed.is_empty() {
+        eprintln!(
+            "xtask: building the images ahead failed ({}); their checks build them again",
+            failed.join(", ")
+        );
     }
 }

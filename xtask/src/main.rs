@@ -132,7 +132,7 @@ fn test() -> Result<()> {
         )
     })?;
     // The host tests need tmux, the images the target and flip-link.
-    times.step("setup", || installing.join())?;
+    times.step("setup", || setup::join(installing))?;
     let python = times.step("python", setup::python)?;
     times.step("rooms", || check("rooms", None))?;
     let images = images::ahead()?;
@@ -142,7 +142,7 @@ fn test() -> Result<()> {
     times.step("fleet", || check("fleet", Some(&python)))?;
     times.step("can", || check("can", Some(&python)))?;
     times.step("images", || {
-        images.join();
+        images::join(images);
         Ok(())
     })?;
     times.step("firmware", || check("fw-size", None))?;

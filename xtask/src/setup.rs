@@ -17,9 +17,10 @@
 //! host build ([`beside`]), which needs none of it: on a fresh machine its time is mostly
 //! waiting on the network and the package manager, which the build's compilations fill.
 
+use crate::beside::{self, Beside, Unjoined};
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 
 /// Tools found on `PATH` by name, the argument that makes each print its version and exit
 /// successfully (QEMU refuses tmux's `-V`), and the Debian package that has each.
@@ -188,58 +189,26 @@ pub fn everything() -> Result<()> {
     python().map(|_| ())
 }
 
-/// The setup running in a child process (`cargo xtask setup`, this executable), its output
-/// going to a file.
-pub struct Beside {
-    child: Option<Child>,
-    log: PathBuf,
-}
-
-/// Starts [`everything`] in a child process, its output written to `target/setup.log`.
+/// Starts [`everything`] in a child process (`cargo xtask setup`, this executable,
+/// [`beside`], output in `target/setup.log`); dropped unjoined (a step before failed), it
+/// is waited for.
 pub fn beside() -> Result<Beside> {
-    let log = crate::workspace::target_dir().join("setup.log");
-    std::fs::create_dir_all(crate::workspace::target_dir())?;
-    let file =
-        std::fs::File::create(&log).with_context(|| format!("creating {}", log.display()))?;
     let exe = std::env::current_exe().context("this task's executable, for its setup")?;
-    let child = Command::new(exe)
-        .arg("setup")
-        .stdin(Stdio::null())
-        .stdout(file.try_clone()?)
-        .stderr(file)
-        .spawn()
-        .context("could not start the setup beside the build")?;
-    Ok(Beside {
-        child: Some(child),
-        log,
-    })
+    let mut setup = Command::new(exe);
+    setup.arg("setup");
+    beside::start(
+        "setup, run beside the build",
+        "setup.log",
+        [setup],
+        Unjoined::Wait,
+    )
 }
 
-impl Beside {
-    /// Waits for the setup, shows its output and fails when it did.
-    pub fn join(mut self) -> Result<()> {
-        let status = match self.child.take() {
-            Some(mut child) => child.wait().context("waiting for the setup")?,
-            None => return Ok(()),
-        };
-        eprintln!("\n=== setup, run beside the build:");
-        match std::fs::read_to_string(&self.log) {
-            Ok(text) => eprint!("{text}"),
-            Err(e) => eprintln!("({}: {e})", self.log.display()),
-        }
-        if !status.success() {
-            bail!("setup failed ({status}; its output above)");
-        }
-        Ok(())
+/// Waits for the setup started by [`beside`], shows its output and fails when it did.
+pub fn join(setup: Beside) -> Result<()> {
+    let failed = setup.join();
+    if !failed.is_empty() {
+        bail!("setup failed ({}; its output above)", failed.join(", "));
     }
-}
-
-impl Drop for Beside {
-    /// A step before failed: the setup is waited for, not killed (apt-get and dpkg must
-    /// not be cut off halfway).
-    fn drop(&mut self) {
-        if let Some(mut child) = self.child.take() {
-            let _ = child.wait();
-        }
-    }
+    Ok(())
 }

@@ -33,8 +33,9 @@ const CLIPPY_ARGS: &str = "-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__";
 /// dependencies by rustc as in any build. One compilation both lints the code and makes the
 /// test binaries, where `cargo clippy` followed by `cargo test` checked every crate once more
 /// without building it. Every host build of the tasks goes through here, so none of them
-/// rebuilds what another built. Cargo fingerprints the wrapper: a plain `cargo test` in the same target directory compiles the
-/// workspace's crates again (not their dependencies), and so do the tasks after it.
+/// rebuilds what another built. Cargo fingerprints the wrapper: a plain `cargo test` in the
+/// same target directory compiles the workspace's crates again (not their dependencies),
+/// and so do the tasks after it.
 ///
 /// Cargo runs `cargo xtask`'s own executable as the wrapper, which hands each call to
 /// `clippy-driver` and compiles the unit tests of the optimised simulation libraries at a

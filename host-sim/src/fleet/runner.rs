@@ -9,7 +9,7 @@
 //! sampled, so the run reports how much memory a worker took.
 
 use super::cache::Outcome;
-use crate::output::{interrupt, paths};
+use crate::output::{interrupt, paths, transaction};
 use serde_json::Value;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -200,25 +200,13 @@ impl Runner {
 }
 
 /// Removes what the child `pid`, killed while it checked or wrote `json`, left beside
-/// it: its probe of the folder and its staged copies `.NAME.*.eha-tmp` (a killed process
-/// cannot remove them itself, [`interrupt`]). The JSON's name holds this process's id and
-/// a counter, so nothing else matches.
+/// it: its probe of the folder and its staged copies of `json`. The JSON's name holds this
+/// process's id and a counter, so nothing else matches.
 fn remove_left_behind(json: &Path, pid: u32) {
-    let (Some(dir), Some(name)) = (json.parent(), json.file_name()) else {
-        return;
-    };
-    let _ = std::fs::remove_file(paths::probe_path(dir, pid));
-    let prefix = format!(".{}.", name.to_string_lossy());
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let n = entry.file_name();
-        let n = n.to_string_lossy();
-        if n.starts_with(&prefix) && n.ends_with(".eha-tmp") {
-            let _ = std::fs::remove_file(entry.path());
-        }
+    if let Some(dir) = json.parent() {
+        let _ = std::fs::remove_file(paths::probe_path(dir, pid));
     }
+    transaction::remove_staged_files(json);
 }
 
 /// What a finished child's exit status and output mean.

@@ -140,6 +140,25 @@ fn hidden_prefix(place: &Path) -> String {
     format!(".{name}.")
 }
 
+/// The suffix of a file staged beside its place (`.NAME.RANDOM.eha-tmp`).
+const STAGED_FILE_SUFFIX: &str = ".eha-tmp";
+
+/// Removes the files staged for `place` that a process killed before its commit left
+/// beside it (a killed process cannot remove them itself, [`interrupt`]).
+pub fn remove_staged_files(place: &Path) {
+    let prefix = hidden_prefix(place);
+    let Ok(entries) = fs::read_dir(parent_of(place)) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if name.starts_with(&prefix) && name.ends_with(STAGED_FILE_SUFFIX) {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
+}
+
 impl Outputs {
     /// No outputs yet.
     pub fn new() -> Outputs {
@@ -164,7 +183,8 @@ impl Outputs {
         let place = existing.clone().unwrap_or_else(|| path.to_path_buf());
         let prefix = hidden_prefix(&place);
         let (file, guard) = interrupt::held(|pending| {
-            let file = staging_builder(&prefix, ".eha-tmp").tempfile_in(parent_of(&place))?;
+            let file =
+                staging_builder(&prefix, STAGED_FILE_SUFFIX).tempfile_in(parent_of(&place))?;
             let guard = pending.register(file.path());
             Ok((file, guard))
         })

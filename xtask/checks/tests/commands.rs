@@ -1,6 +1,7 @@
 //! The checks' executable as `cargo xtask` runs it: an unknown command is a usage error
 //! (exit 2), `dbc --node N --out` addresses every message to node N and refuses a node the
-//! protocol has not, and `rooms --root` fails on a checkout with a file over the line limit, naming it.
+//! protocol has not, and `rooms --root` fails on a checkout with a file over the line limit,
+//! naming it.
 //!
 //! Cargo builds the executable for these tests, so the workspace's linted test build makes
 //! it with the features the whole workspace resolves (what `cargo xtask test` runs).
