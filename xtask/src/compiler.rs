@@ -10,8 +10,10 @@
 //! seconds either way. Cargo has no setting per target, so the wrapper Cargo runs for the
 //! workspace's crates (`RUSTC_WORKSPACE_WRAPPER`) appends a lower `-C opt-level` to those
 //! compilations ([`UNIT_TEST_OPT_LEVELS`]; rustc takes a codegen option's last value) and
-//! hands every call to `clippy-driver` unchanged otherwise. Optimisation does not change a
-//! floating-point result here (no fast-math), so the tests check the same numbers.
+//! hands every call to `clippy-driver` unchanged otherwise. Their integration tests,
+//! benchmarks and examples are compiled unoptimised the same way
+//! ([`helper_target_opt_level`]). Optimisation does not change a floating-point result
+//! here (no fast-math), so the tests check the same numbers.
 //!
 //! Cargo calls the wrapper as `WRAPPER RUSTC ARGS…`; this executable knows the call by
 //! [`DRIVER_VAR`] in its environment, set only by [`crate::workspace::linted_cargo`], and
@@ -20,7 +22,7 @@
 //! change (only the build's time depends on it).
 
 use std::ffi::{OsStr, OsString};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// Environment variable holding the `clippy-driver` the wrapper hands its calls to.
@@ -56,7 +58,12 @@ pub fn wrap_if_called() {
     }
     let mut cmd = Command::new(&driver);
     cmd.args(&args);
-    if let Some(level) = unit_test_opt_level(&args) {
+    let package = std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from);
+    let level = unit_test_opt_level(&args).or_else(|| {
+        let cwd = std::env::current_dir().ok()?;
+        helper_target_opt_level(&args, &cwd, package.as_deref()?)
+    });
+    if let Some(level) = level {
         cmd.arg(format!("-Copt-level={level}"));
     }
     let code = match cmd.status() {
@@ -86,6 +93,31 @@ fn unit_test_opt_level(args: &[OsString]) -> Option<&'static str> {
         .iter()
         .find(|(name, _)| crate_name == OsStr::new(name))
         .map(|(_, level)| *level)
+}
+
+/// The folders of a package whose crates are its integration tests, benchmarks and
+/// examples (Cargo's conventional places).
+const HELPER_TARGET_DIRS: [&str; 3] = ["tests", "benches", "examples"];
+
+/// The optimisation level of the compiler call `args` (run in `cwd`, for the package in
+/// `package`) when its crate root lies in one of [`HELPER_TARGET_DIRS`]: "0". The dev
+/// profile's level is the package's, for every target; the optimised packages' tests,
+/// benchmarks and examples call the library (optimised) for their heavy work, or run `eha`,
+/// and the linted build only compiles the benchmarks and examples, so optimising them again
+/// costs compile time the runs do not give back. A plain `cargo test`, `cargo run
+/// --example` or `cargo bench` keeps the profile's level.
+fn helper_target_opt_level(args: &[OsString], cwd: &Path, package: &Path) -> Option<&'static str> {
+    let root = args
+        .iter()
+        .filter(|a| !a.to_string_lossy().starts_with('-'))
+        .map(Path::new)
+        .find(|a| a.extension() == Some(OsStr::new("rs")))?;
+    let root = cwd.join(root);
+    let first = root.strip_prefix(package).ok()?.components().next()?;
+    HELPER_TARGET_DIRS
+        .iter()
+        .any(|d| first.as_os_str() == OsStr::new(d))
+        .then_some("0")
 }
 
 #[cfg(test)]
@@ -128,5 +160,43 @@ mod tests {
         );
         // A crate whose name only contains a listed one.
         assert_eq!(level("rustc --crate-name host_sim_extra --test x.rs"), None);
+    }
+
+    #[test]
+    fn a_packages_tests_benchmarks_and_examples_take_level_0() {
+        let ws = Path::new("/w");
+        let pkg = Path::new("/w/host-sim");
+        let level = |line: &str| helper_target_opt_level(&call(line), ws, pkg);
+        assert_eq!(
+            level("rustc --crate-name cli --edition=2021 host-sim/tests/cli.rs --test"),
+            Some("0")
+        );
+        assert_eq!(
+            level(
+                "rustc --crate-name closed_loop host-sim/benches/closed_loop.rs --crate-type bin"
+            ),
+            Some("0")
+        );
+        assert_eq!(
+            level("rustc --crate-name residual_budget /w/host-sim/examples/residual_budget.rs"),
+            Some("0")
+        );
+        // The library, its unit tests and the executable keep the profile's level.
+        assert_eq!(
+            level("rustc --crate-name host_sim host-sim/src/lib.rs"),
+            None
+        );
+        assert_eq!(
+            level("rustc --crate-name host_sim host-sim/src/lib.rs --test"),
+            None
+        );
+        assert_eq!(level("rustc --crate-name eha host-sim/src/main.rs"), None);
+        // Another package's tests, a file named like the folders elsewhere, no crate root.
+        assert_eq!(
+            level("rustc --crate-name faults plant-model/tests/faults.rs --test"),
+            None
+        );
+        assert_eq!(level("rustc --crate-name x host-sim/src/tests.rs"), None);
+        assert_eq!(level("rustc -vV"), None);
     }
 }
