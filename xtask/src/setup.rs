@@ -8,8 +8,8 @@
 //! - `tmux`, the terminal `eha watch`'s screen test runs the live view in;
 //! - Python's `cantools`, `dask` and `distributed` (pinned in `xtask/requirements.txt`) in a
 //!   virtual environment under the target directory, for the DBC check and the fleet's Dask
-//!   driver. `EHA_PYTHON` names an interpreter that has them already (`.ci/run` makes one);
-//!   a missing or broken one is an error, never a skip.
+//!   driver. `EHA_PYTHON` names an interpreter that has them already instead; a missing or
+//!   broken one is an error, never a skip.
 //!
 //! apt-get runs only when something is missing, after `apt-get update`.
 //!
@@ -179,6 +179,19 @@ pub fn python() -> Result<PathBuf> {
         bail!("{} cannot `{IMPORTS}` after pip install", python.display());
     }
     Ok(python)
+}
+
+/// Prints the versions of the checks' Python packages that `python` imports, so a run's
+/// log says what it checked against.
+pub fn show_versions(python: &std::path::Path) -> Result<()> {
+    crate::workspace::run(
+        "the checks' Python packages",
+        Command::new(python).args([
+            "-c",
+            "import cantools, dask, distributed; print('python packages: cantools', \
+             cantools.__version__, 'dask', dask.__version__, 'distributed', distributed.__version__)",
+        ]),
+    )
 }
 
 /// Everything above: the target, the linker, the tools, the Python environment (`cargo
