@@ -133,11 +133,7 @@ fn test() -> Result<()> {
     })?;
     // The host tests need tmux, the images the target and flip-link.
     times.step("setup", || setup::join(installing))?;
-    let python = times.step("python", || {
-        let python = setup::python()?;
-        setup::show_versions(&python)?;
-        Ok(python)
-    })?;
+    let python = times.step("python", setup::python)?;
     times.step("rooms", || check("rooms", None))?;
     let images = images::ahead()?;
     times.step("host tests", || {

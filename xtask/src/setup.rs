@@ -122,13 +122,29 @@ pub fn tools() -> Result<()> {
 /// What the checks import: cantools (the DBC check), dask.distributed (the fleet check).
 const IMPORTS: &str = "import cantools, dask.distributed";
 
-fn has_packages(python: &std::path::Path) -> bool {
-    Command::new(python)
-        .args(["-c", IMPORTS])
-        .stdout(Stdio::null())
+/// The versions of the checks' packages as `python` imports them, or `None` when it
+/// cannot import them.
+fn packages(python: &std::path::Path) -> Option<String> {
+    let script = format!(
+        "{IMPORTS}; print('cantools', cantools.__version__, 'dask', dask.__version__, \
+         'distributed', dask.distributed.__version__)"
+    );
+    let out = Command::new(python)
+        .args(["-c", &script])
         .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
+        .output()
+        .ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+/// `python` when it has the checks' packages, their versions shown so a run's log says
+/// what it checked against.
+fn with_packages(python: PathBuf) -> Option<PathBuf> {
+    let versions = packages(&python)?;
+    eprintln!("{}: {versions}", python.display());
+    Some(python)
 }
 
 /// A Python interpreter with `cantools`, `dask` and `distributed`: `EHA_PYTHON`, or the
@@ -137,17 +153,16 @@ fn has_packages(python: &std::path::Path) -> bool {
 pub fn python() -> Result<PathBuf> {
     if let Some(p) = std::env::var_os("EHA_PYTHON") {
         let p = PathBuf::from(p);
-        if !has_packages(&p) {
-            bail!(
+        return with_packages(p.clone()).with_context(|| {
+            format!(
                 "EHA_PYTHON={} cannot `{IMPORTS}` (pip install -r xtask/requirements.txt)",
                 p.display()
-            );
-        }
-        return Ok(p);
+            )
+        });
     }
     let venv = crate::workspace::target_dir().join("py-venv");
     let python = venv.join("bin").join("python");
-    if has_packages(&python) {
+    if let Some(python) = with_packages(python.clone()) {
         return Ok(python);
     }
     let make = || {
@@ -175,23 +190,8 @@ pub fn python() -> Result<PathBuf> {
             ),
     )
     .context("installing the checks' Python packages with pip")?;
-    if !has_packages(&python) {
-        bail!("{} cannot `{IMPORTS}` after pip install", python.display());
-    }
-    Ok(python)
-}
-
-/// Prints the versions of the checks' Python packages that `python` imports, so a run's
-/// log says what it checked against.
-pub fn show_versions(python: &std::path::Path) -> Result<()> {
-    crate::workspace::run(
-        "the checks' Python packages",
-        Command::new(python).args([
-            "-c",
-            "import cantools, dask, distributed; print('python packages: cantools', \
-             cantools.__version__, 'dask', dask.__version__, 'distributed', distributed.__version__)",
-        ]),
-    )
+    let shown = python.display().to_string();
+    with_packages(python).with_context(|| format!("{shown} cannot `{IMPORTS}` after pip install"))
 }
 
 /// Everything above: the target, the linker, the tools, the Python environment (`cargo
