@@ -9,6 +9,7 @@
 
 use crate::bench_log::{BenchLog, Signal};
 pub use crate::diagnose::low_side::LowSide;
+use crate::diagnose::speed_angle::integrated_angle;
 use crate::diagnose::{low_side, unseen_motion};
 use plant_model::Rig;
 use std::f64::consts::PI;
@@ -82,6 +83,11 @@ pub struct LogFacts {
     pub theta_rad: Vec<f64>,
     /// Whether `theta_rad` was logged (else integrated, so its absolute phase is unknown).
     pub angle_logged: bool,
+    /// Whether `theta_rad`, not logged, is the encoder's counted angle integrated back from
+    /// a count-difference speed ([`crate::diagnose::speed_angle`]): exact but for its
+    /// unknown start, so the lines' phases combine across windows though their absolute
+    /// phase is unknown.
+    pub angle_counted: bool,
     /// The rig's fill pressure, the low side's (port B) where the log does not hold it
     /// ([`LogFacts::p_low`]). [Pa]
     pub fill_low_pa: f64,
@@ -140,9 +146,12 @@ impl LogFacts {
         let uniform = t
             .windows(2)
             .all(|w| ((w[1] - w[0]) / period_s - 1.0).abs() < 0.01);
-        let (theta_rad, angle_logged) = match log.theta_m_rad.as_deref() {
-            Some(th) => (unwrap_angle(th), true),
-            None => (integrated_angle(t, &log.speed_rad_s), false),
+        let (theta_rad, angle_logged, angle_counted) = match log.theta_m_rad.as_deref() {
+            Some(th) => (unwrap_angle(th), true, false),
+            None => {
+                let (theta, counted) = integrated_angle(t, &log.speed_rad_s);
+                (theta, false, counted)
+            }
         };
         let fill_low_pa = rig.fill.pressure_pa;
         let p_low = LowSide::of(log, fill_low_pa);
@@ -208,6 +217,7 @@ impl LogFacts {
             uniform,
             theta_rad,
             angle_logged,
+            angle_counted,
             fill_low_pa,
             fill_pa,
             low_side_apart,
@@ -404,19 +414,6 @@ pub fn unwrap_angle(wrapped: &[f64]) -> Vec<f64> {
     out
 }
 
-/// The shaft angle the logged speed integrates to (trapezoids), from 0. [rad]
-pub fn integrated_angle(t: &[f64], speed: &[f64]) -> Vec<f64> {
-    let mut theta = Vec::with_capacity(t.len());
-    let mut acc = 0.0;
-    for k in 0..t.len().min(speed.len()) {
-        if k > 0 {
-            acc += 0.5 * (speed[k] + speed[k - 1]) * (t[k] - t[k - 1]);
-        }
-        theta.push(acc);
-    }
-    theta
-}
-
 /// Steady-rotation windows: the log cut into chunks of [`STEADY_CHUNK_S`], consecutive
 /// chunks whose mean speeds stay within [`STEADY_SPREAD`] of the window's mean joined. A
 /// window closes once it holds [`STEADY_TARGET_REVOLUTIONS`] and [`STEADY_TARGET_S`] (or
@@ -535,15 +532,6 @@ mod tests {
         let back: Vec<f64> = truth.iter().map(|a| (-a).rem_euclid(2.0 * PI)).collect();
         let u = unwrap_angle(&back);
         assert!((u[99] - u[0] + 0.3 * 99.0).abs() < 1e-9);
-    }
-
-    #[test]
-    fn the_speed_integrates_to_the_angle_turned() {
-        // A ramp 0 → 20 rad/s over 1 s turns ½·20·1 = 10 rad (trapezoids are exact on a ramp).
-        let t: Vec<f64> = (0..1001).map(|k| k as f64 * 1e-3).collect();
-        let w: Vec<f64> = t.iter().map(|&t| 20.0 * t).collect();
-        let th = integrated_angle(&t, &w);
-        assert!((th[1000] - 10.0).abs() < 1e-9, "{}", th[1000]);
     }
 
     #[test]

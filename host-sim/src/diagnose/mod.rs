@@ -67,6 +67,7 @@ pub mod secant;
 pub mod selection;
 pub mod signatures;
 pub mod spectrum;
+pub mod speed_angle;
 pub mod stick;
 #[cfg(test)]
 mod test_noise;

@@ -1,0 +1,248 @@
+//! The shaft angle of a log without `theta_m_rad`, integrated from its speed column.
+//!
+//! A bench's speed column is one of two kinds, and the angles they integrate to differ by
+//! half a row:
+//!
+//! - a count difference over the row's interval, ω_k = (θ_k − θ_{k−1})/(t_k − t_{k−1}) with θ
+//!   the encoder's counted angle (what a logger computes from the counter it reads at each
+//!   row): the mean speed over the interval that ends at t_k, whose running sum
+//!   θ_k = θ_{k−1} + ω_k·(t_k − t_{k−1}) is the counted angle itself;
+//! - a sample of a continuous estimate (an observer's, a filter's, or a difference taken at
+//!   the control rate, far faster than the log's): the speed at t_k, which integrates by
+//!   trapezoids.
+//!
+//! Taken for the other kind, the angle is half a row early or late, and whatever is read from
+//! it follows: the pump's flow D_p·ω shifts by Δt/2, a flow error D_p·α·Δt/2 that a stiff
+//! hydraulic node turns into a pressure residual many times its noise on every ramp. The first
+//! kind shows itself ([`count_step`]): its increments ω_k·Δt_k are whole numbers of one
+//! encoder count 2π/N, and they jitter by whole counts about the smooth motion (the counter's
+//! rounding, whose second differences have an rms of about 0.7 of a count). A continuous
+//! estimate's increments lie on no lattice, or, sampled from a motion as smooth as a ramp,
+//! on one without that jitter. Only a log sampled at even intervals is read as counted: where
+//! rows are missing, a logger's difference over its own interval no longer spans the row's.
+
+/// Largest departure of an interval from the mean one in an evenly sampled log (the time
+/// column's printed rounding). [1]
+const EVEN_SPREAD: f64 = 0.01;
+
+/// Fewest moving rows from which the counts' lattice is read.
+const MIN_MOVING_ROWS: usize = 50;
+
+/// Largest distance of an increment from the lattice, in counts, that still counts as on it
+/// (the printed speed's rounding is far less).
+const LATTICE_TOLERANCE: f64 = 0.1;
+
+/// Share of the moving rows that must lie on the lattice: a continuous estimate puts about
+/// a fifth there by chance.
+const LATTICE_SHARE: f64 = 0.98;
+
+/// Least rms of the increments' second differences, in counts, of a counter's rounding
+/// (about 0.7 where the rounding is uniform, more where single counts come and go at a
+/// crawl); a smoothly sampled speed's are a small fraction of its lattice's step.
+const MIN_ROUNDING_RMS: f64 = 0.2;
+
+/// Increments smaller than this share of the median moving increment are taken as equal
+/// values printed differently, not as a count.
+const PRINT_FLOOR: f64 = 1e-6;
+
+/// The shaft angle the logged `speed` integrates to from 0 at the times `t`, by the rule its
+/// kind asks for (module docs), and whether the speed is a count difference (the angle is
+/// then the counted one, up to the counter's value at the first row). [rad]
+pub fn integrated_angle(t: &[f64], speed: &[f64]) -> (Vec<f64>, bool) {
+    let n = t.len().min(speed.len());
+    let increments: Vec<f64> = (1..n).map(|k| speed[k] * (t[k] - t[k - 1])).collect();
+    let counted = evenly_sampled(&t[..n]) && count_step(&increments).is_some();
+    let mut theta = Vec::with_capacity(n);
+    let mut acc = 0.0;
+    for k in 0..n {
+        if k > 0 {
+            acc += if counted {
+                increments[k - 1]
+            } else {
+                0.5 * (speed[k] + speed[k - 1]) * (t[k] - t[k - 1])
+            };
+        }
+        theta.push(acc);
+    }
+    (theta, counted)
+}
+
+/// Whether every interval of `t` is within [`EVEN_SPREAD`] of the mean interval.
+fn evenly_sampled(t: &[f64]) -> bool {
+    let n = t.len();
+    if n < 2 {
+        return false;
+    }
+    let mean = (t[n - 1] - t[0]) / (n - 1) as f64;
+    t.windows(2)
+        .all(|w| ((w[1] - w[0]) / mean - 1.0).abs() <= EVEN_SPREAD)
+}
+
+/// The angle of one encoder count when every increment ω_k·Δt_k of the log is a whole
+/// number of it (the speed is a count difference over the row), else `None`. [rad]
+pub fn count_step(increments: &[f64]) -> Option<f64> {
+    let moving: Vec<f64> = increments
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite() && *d != 0.0)
+        .collect();
+    if moving.len() < MIN_MOVING_ROWS {
+        return None;
+    }
+    let mut sizes: Vec<f64> = moving.iter().map(|d| d.abs()).collect();
+    sizes.sort_by(f64::total_cmp);
+    let floor = PRINT_FLOOR * sizes[sizes.len() / 2];
+    // One count is the smallest step the increments take: the smallest increment, or the
+    // smallest change between neighbours (at speed, where no increment is a single count).
+    let step = moving
+        .iter()
+        .map(|d| d.abs())
+        .chain(moving.windows(2).map(|w| (w[1] - w[0]).abs()))
+        .filter(|s| *s > floor)
+        .fold(f64::INFINITY, f64::min);
+    if !step.is_finite() {
+        return None;
+    }
+    // Refined by least squares on the counts it assigns (the printed speed's rounding).
+    let counts = |step: f64| moving.iter().map(move |d| (d / step).round());
+    let (num, den) = counts(step)
+        .zip(&moving)
+        .fold((0.0, 0.0), |(num, den), (c, d)| (num + c * d, den + c * c));
+    let step = if den > 0.0 { num / den } else { step };
+    let on = counts(step)
+        .zip(&moving)
+        .filter(|(c, d)| (*d / step - c).abs() <= LATTICE_TOLERANCE)
+        .count();
+    if (on as f64) < LATTICE_SHARE * moving.len() as f64 {
+        return None;
+    }
+    // The counter's rounding: second differences where the shaft moves.
+    let (sum, n) = increments
+        .windows(3)
+        .filter(|w| w.iter().any(|d| *d != 0.0))
+        .fold((0.0, 0usize), |(sum, n), w| {
+            let dd = (w[2] - 2.0 * w[1] + w[0]) / step;
+            (sum + dd * dd, n + 1)
+        });
+    (n > 0 && (sum / n as f64).sqrt() >= MIN_ROUNDING_RMS).then_some(step)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// A shaft accelerating from rest and oscillating, θ(t) = 3·t² + 0.2·sin(40·t). [rad]
+    fn motion(t: f64) -> f64 {
+        3.0 * t * t + 0.2 * (40.0 * t).sin()
+    }
+
+    #[test]
+    fn the_speed_integrates_to_the_angle_turned() {
+        // A ramp 0 → 20 rad/s over 1 s turns ½·20·1 = 10 rad (trapezoids are exact on a ramp).
+        let t: Vec<f64> = (0..1001).map(|k| k as f64 * 1e-3).collect();
+        let w: Vec<f64> = t.iter().map(|&t| 20.0 * t).collect();
+        let (th, _) = integrated_angle(&t, &w);
+        assert!((th[1000] - 10.0).abs() < 1e-9, "{}", th[1000]);
+    }
+
+    #[test]
+    fn a_count_difference_integrates_back_to_the_counted_angle() {
+        // An 8192-count encoder read every millisecond, the speed printed to 5 decimals as a
+        // logger writes it: the angle is the counts' own, not half a row late.
+        let counts_per_rev = 8192.0;
+        let q = 2.0 * PI / counts_per_rev;
+        let t: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
+        let counts: Vec<f64> = t.iter().map(|&t| (motion(t) / q).floor()).collect();
+        let w: Vec<f64> = (0..t.len())
+            .map(|k| {
+                let c = if k == 0 {
+                    0.0
+                } else {
+                    counts[k] - counts[k - 1]
+                };
+                (c * q / 1e-3 * 1e5).round() / 1e5
+            })
+            .collect();
+        let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
+        let step = count_step(&increments).expect("a lattice");
+        assert!((step / q - 1.0).abs() < 1e-4, "{step} against {q}");
+        let (th, _) = integrated_angle(&t, &w);
+        for k in (0..t.len()).step_by(97) {
+            let counted = (counts[k] - counts[0]) * q;
+            assert!(
+                (th[k] - counted).abs() < 1e-5,
+                "row {k}: {} vs {counted}",
+                th[k]
+            );
+        }
+    }
+
+    #[test]
+    fn a_continuous_estimate_is_not_taken_for_counts() {
+        // The speed sampled from the motion itself: no lattice, trapezoids, and the angle
+        // within the trapezoids' error of the motion (h²/12·max|θ'''| per unit time).
+        let t: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
+        let w: Vec<f64> = t
+            .iter()
+            .map(|&t| 6.0 * t + 8.0 * (40.0 * t).cos())
+            .collect();
+        let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
+        assert_eq!(count_step(&increments), None);
+        let (th, _) = integrated_angle(&t, &w);
+        let bound = 4.0 * 1e-6 / 12.0 * 0.2 * 40.0f64.powi(3);
+        for k in (0..t.len()).step_by(97) {
+            let truth = motion(t[k]) - motion(0.0);
+            assert!(
+                (th[k] - truth).abs() < bound,
+                "row {k}: {} vs {truth}",
+                th[k]
+            );
+        }
+    }
+
+    #[test]
+    fn a_log_with_rows_missing_is_integrated_by_trapezoids() {
+        // Every tenth row of a counted log dropped: the speed still spans one logger
+        // interval, not the row's two, so the rule falls back to trapezoids.
+        let q = 2.0 * PI / 8192.0;
+        let all: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
+        let counts: Vec<f64> = all.iter().map(|&t| (motion(t) / q).floor()).collect();
+        let keep: Vec<usize> = (0..all.len()).filter(|k| k % 10 != 5).collect();
+        let t: Vec<f64> = keep.iter().map(|&k| all[k]).collect();
+        let w: Vec<f64> = keep
+            .iter()
+            .map(|&k| {
+                if k == 0 {
+                    0.0
+                } else {
+                    (counts[k] - counts[k - 1]) * q / 1e-3
+                }
+            })
+            .collect();
+        let (_, counted) = integrated_angle(&t, &w);
+        assert!(!counted);
+        let (_, counted) = integrated_angle(&all, &{
+            let mut w = vec![0.0];
+            w.extend((1..all.len()).map(|k| (counts[k] - counts[k - 1]) * q / 1e-3));
+            w
+        });
+        assert!(counted);
+    }
+
+    #[test]
+    fn a_sampled_ramp_is_not_taken_for_counts() {
+        // A speed ramp sampled without rounding: its increments are multiples of α·Δt², a
+        // lattice, but with no counter's jitter on it.
+        let t: Vec<f64> = (0..1001).map(|k| k as f64 * 1e-3).collect();
+        let w: Vec<f64> = t.iter().map(|&t| 20.0 * t).collect();
+        let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
+        assert_eq!(count_step(&increments), None);
+    }
+
+    #[test]
+    fn a_shaft_that_barely_moves_shows_no_lattice() {
+        let increments = [0.0, 1e-3, 0.0, -1e-3, 0.0];
+        assert_eq!(count_step(&increments), None);
+    }
+}
