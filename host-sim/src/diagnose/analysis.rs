@@ -270,7 +270,8 @@ pub fn analyse_reporting(
         shaft,
         orders,
         LineReading {
-            coherent: facts.angle_logged,
+            coherent: facts.angle_logged || facts.angle_counted,
+            absolute: facts.angle_logged,
             emf: match &cal.electrical {
                 Some(c) => EmfLines::Voltages(super::electrical::stator(&c.fitted.values)),
                 None => EmfLines::Currents,

@@ -128,8 +128,10 @@ pub struct LineFit {
     pub dof: usize,
     /// Windows used.
     pub windows: usize,
-    /// Whether the phases were combined (the angle was logged).
+    /// Whether the phases were combined (the angle was logged or counted).
     pub coherent: bool,
+    /// Whether the phases are against the true angle (the angle was logged).
+    pub absolute: bool,
     /// The flux harmonics' back-EMF lines fitted with the torque line.
     pub emf: EmfLines,
     /// Flux harmonics with the voltages: their voltage lines read as a back-EMF and as a
@@ -217,7 +219,7 @@ fn amplitude_of(obs: &[Observation], free_d: bool) -> Option<(Complex64, f64)> {
 /// ([`super::back_emf`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EmfLines {
-    /// None: the torque line alone (the angle is not logged).
+    /// None: the torque line alone (the lines' phases are not combined).
     None,
     /// The d- and q-current lines, as the current loops pass it (no voltages logged).
     Currents,
@@ -239,8 +241,10 @@ impl EmfLines {
 /// How the lines of a log are read.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LineReading {
-    /// The angle is logged: the windows' phases are combined.
+    /// The angle is logged or counted: the windows' phases are combined.
     pub coherent: bool,
+    /// The angle is logged: the lines' phases are those against the true angle.
+    pub absolute: bool,
     /// The back-EMF lines the flux harmonics are fitted with (only with the angle).
     pub emf: EmfLines,
 }
@@ -296,6 +300,7 @@ pub fn fit_line(
         dof,
         windows: per_window.len(),
         coherent,
+        absolute: reading.absolute,
         emf,
         emf_law: emf_law(&emf_lines, crate::diagnose::dead_time::max_scale(rig)),
     })
@@ -369,15 +374,24 @@ pub const OFFSET_HYPOTHESES: [(&str, f64, f64); 5] = [
     ("phase b, two-sensor Clarke", 90.0, 1.154_700_538_379_251_5),
 ];
 
+/// The hypothesis read when the log has no angle, so that the line's phase (which tells
+/// the arrangement) is unknown: two sensors, the offset on phase a. A log without the angle
+/// does not come from this project's drive, whose telemetry always carries it; two isolated
+/// current sensors (the third phase computed) is the usual arrangement of servo drives at the
+/// rig's DC-link voltage, and the one the independent bench's logs show wherever they hold
+/// the angle. The same line is √3 times the offset behind a three-sensor transform, which the
+/// cause's text gives beside it.
+pub const UNSEEN_ARRANGEMENT: usize = 3;
+
 /// The offset (signed, A) and its hypothesis from the torque line's complex amplitude `a`
-/// (coherent: phase against the electrical angle p_n·θ_m); without a phase the first
-/// hypothesis (this project's controller) and a positive sign.
+/// (coherent: phase against the electrical angle p_n·θ_m). Without a phase the arrangement
+/// cannot be seen and [`UNSEEN_ARRANGEMENT`] is read, with a positive sign.
 ///
 /// The image (α, β) = m·off·(cos φ, sin φ) appears in the measured q current as
 /// m·off·sin(φ − θ_e), i.e. the line K_t·m·off·j·e^{−jφ} against e^{jθ_e}.
 pub fn offset_from_line(a: Complex64, kt: f64, coherent: bool) -> (f64, &'static str) {
     if !coherent {
-        let (label, _, m) = OFFSET_HYPOTHESES[0];
+        let (label, _, m) = OFFSET_HYPOTHESES[UNSEEN_ARRANGEMENT];
         return (a.norm() / (kt * m), label);
     }
     let angle = a.arg().to_degrees();
@@ -464,6 +478,21 @@ mod tests {
         assert!(label.contains("phase a, three"), "{label}");
         let (off, _) = offset_from_line(-a, kt, true);
         assert!((off + 0.3).abs() < 1e-9, "{off}");
+    }
+
+    #[test]
+    fn without_the_angle_the_line_reads_as_a_two_sensor_offset() {
+        // Two sensors (c = −a − b), offset 0.15 A on phase a: α = 0.15, β = 0.15/√3, an image
+        // of 0.15·2/√3 A whatever its phase; a three-sensor transform's image would be
+        // 0.15·2/3 A, √3 times smaller.
+        let kt = 1.0962;
+        let image = 0.15 * 2.0 / 3f64.sqrt();
+        for phase in [0.0f64, 1.0, 2.5] {
+            let a = Complex64::from_polar(image * kt, phase);
+            let (off, label) = offset_from_line(a, kt, false);
+            assert!((off - 0.15).abs() < 1e-9, "{off}");
+            assert!(label.contains("two-sensor"), "{label}");
+        }
     }
 
     #[test]

@@ -22,7 +22,7 @@
 
 use crate::diagnose::angle_locked::{
     fit_line, line_gain, offset_from_line, plant_phase, LineEffect, LineFit, LineReading,
-    ShaftConstants, OFFSET_HYPOTHESES,
+    ShaftConstants, OFFSET_HYPOTHESES, UNSEEN_ARRANGEMENT,
 };
 use crate::diagnose::calibration::{
     test_release, weighed_sse, Calibration, Relation, Release, ReleaseTest,
@@ -465,18 +465,18 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
     let order = f.effect.order(rig);
     let (parameters, floor, what) = match f.effect {
         LineEffect::CurrentOffset => {
-            let (off, label) = offset_from_line(f.amplitude, kt, f.coherent);
+            let (off, label) = offset_from_line(f.amplitude, kt, f.absolute);
             let per_nm = off.abs() / a.max(f64::MIN_POSITIVE);
             // Without the angle the line's phase cannot tell the sensor arrangement: the
-            // same line is a smaller offset behind a two-sensor Clarke transform.
-            let other = if f.coherent {
+            // same line is a larger offset behind a three-sensor Clarke transform.
+            let other = if f.absolute {
                 String::new()
             } else {
-                let two = OFFSET_HYPOTHESES[3];
+                let three = OFFSET_HYPOTHESES[0];
                 format!(
                     "; the angle is not logged, so the arrangement is not seen: behind \
-                     two sensors the same line is {:+.3} A",
-                    off * OFFSET_HYPOTHESES[0].2 / two.2
+                     three sensors the same line is {:+.3} A",
+                    off * OFFSET_HYPOTHESES[UNSEEN_ARRANGEMENT].2 / three.2
                 )
             };
             (
@@ -530,10 +530,10 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         "unexplained torque line at order {order}{with_emf} over {} steady window(s){}: {what}; \
          Λ = {:.1} ({} degrees of freedom){law}",
         f.windows,
-        if f.coherent {
-            ", phase-locked to the logged angle"
-        } else {
-            ""
+        match (f.absolute, f.coherent) {
+            (true, _) => ", phase-locked to the logged angle",
+            (false, true) => ", phase-locked to the angle counted back from the speed",
+            _ => "",
         },
         f.lambda,
         f.dof

@@ -179,6 +179,7 @@ mod tests {
             dof: 4,
             windows: 2,
             coherent: true,
+            absolute: true,
             emf: EmfLines::Voltages(Stator {
                 r_s_ohm: 1.15,
                 l_d_h: 5.5e-3,
