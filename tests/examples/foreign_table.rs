@@ -8,8 +8,11 @@
 //! evidence, and the count by test, nothing hidden, one effect and pairs; the time is of
 //! the diagnosis alone, one run, logs taken one after another.
 //!
+//! `--drop COLUMN[,COLUMN…]` reads every log without those optional columns, as a bench
+//! that did not log them would have written it (`--drop theta_m_rad`: no angle).
+//!
 //! ```text
-//! cargo run --release -p tests --example foreign_table -- DIR
+//! cargo run --release -p tests --example foreign_table -- DIR [--drop COLUMNS]
 //! ```
 
 use std::path::Path;
@@ -19,11 +22,17 @@ use tests::blind::table::score_dir;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let [dir] = args.as_slice() else {
-        eprintln!("usage: foreign_table DIR (bench logs and truth.json)");
-        return ExitCode::from(2);
+    let (dir, drop) = match args.as_slice() {
+        [dir] => (dir, Vec::new()),
+        [dir, flag, columns] if flag == "--drop" => (dir, columns.split(',').collect()),
+        _ => {
+            eprintln!(
+                "usage: foreign_table DIR [--drop COLUMN[,COLUMN…]] (bench logs and truth.json)"
+            );
+            return ExitCode::from(2);
+        }
     };
-    match score_dir(Path::new(dir)) {
+    match score_dir(Path::new(dir), &drop) {
         Ok(tally) => {
             let (right, n) = tally.total();
             println!("\n{}", tally.markdown());

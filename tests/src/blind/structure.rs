@@ -115,17 +115,28 @@ impl Structure {
     /// `log` without the dropped columns.
     pub fn drop_columns(&self, log: &mut BenchLog) {
         for name in &self.dropped {
-            match *name {
-                "ud_v" => log.ud_v = None,
-                "uq_v" => log.uq_v = None,
-                "udc_v" => log.udc_v = None,
-                "x_m" => log.x_m = None,
-                "p_low_pa" => log.p_low_pa = None,
-                "iq_ref_a" => log.iq_ref_a = None,
-                _ => {}
-            }
+            drop_column(log, name);
         }
     }
+}
+
+/// Takes the optional contract column `name` out of `log`; `false` when `name` is not an
+/// optional column (the required ones cannot be dropped).
+pub fn drop_column(log: &mut BenchLog, name: &str) -> bool {
+    let column = match name {
+        "theta_m_rad" => &mut log.theta_m_rad,
+        "x_m" => &mut log.x_m,
+        "p_low_pa" => &mut log.p_low_pa,
+        "speed_ref_rad_s" => &mut log.speed_ref_rad_s,
+        "iq_ref_a" => &mut log.iq_ref_a,
+        "ud_v" => &mut log.ud_v,
+        "uq_v" => &mut log.uq_v,
+        "udc_v" => &mut log.udc_v,
+        "oil_temp_c" => &mut log.oil_temp_c,
+        _ => return false,
+    };
+    *column = None;
+    true
 }
 
 /// Draws a structure: each open part within the range a healthy rig has, the controller's

@@ -10,7 +10,8 @@
 //! for nothing hidden, one effect and pairs.
 
 use super::judge::{failures, main_parameter, read_said, truth_of_entry, Named, Said, Standard};
-use host_sim::bench_log;
+use super::structure::drop_column;
+use host_sim::bench_log::{self, BenchLog};
 use host_sim::diagnose::diagnose;
 use plant_model::Rig;
 use serde_json::Value;
@@ -114,11 +115,20 @@ impl Tally {
     }
 }
 
-/// One log's row, whether it is right, and its failures.
-fn score(dir: &Path, name: &str, entry: &Value) -> Result<(String, bool, Vec<String>), String> {
+/// One log's row, whether it is right, and its failures; the log is read without the
+/// optional columns `drop`.
+fn score(
+    dir: &Path,
+    name: &str,
+    entry: &Value,
+    drop: &[&str],
+) -> Result<(String, bool, Vec<String>), String> {
     let hidden = truth_of_entry(entry).map_err(|e| format!("truth.json: {name}: {e}"))?;
     let path = dir.join(name);
-    let log = bench_log::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut log = bench_log::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    for column in drop {
+        drop_column(&mut log, column);
+    }
     let start = Instant::now();
     let d = diagnose(&log, &Rig::nominal()).map_err(|e| format!("{name}: {e}"))?;
     let seconds = start.elapsed().as_secs_f64();
@@ -159,8 +169,15 @@ fn score(dir: &Path, name: &str, entry: &Value) -> Result<(String, bool, Vec<Str
 
 /// Scores every log `truth.json` in `dir` lists (in name order): prints the table, then the
 /// failures with each cause's evidence line; returns the tally (a log whose entry gives no
-/// `test` counts under `—`).
-pub fn score_dir(dir: &Path) -> Result<Tally, String> {
+/// `test` counts under `—`). Each log is read without the optional columns `drop` (a bench
+/// that did not log them); a name that is not an optional column is an error.
+pub fn score_dir(dir: &Path, drop: &[&str]) -> Result<Tally, String> {
+    let mut probe = BenchLog::default();
+    if let Some(bad) = drop.iter().find(|c| !drop_column(&mut probe, c)) {
+        return Err(format!(
+            "cannot drop `{bad}`: not an optional column of the bench-log contract"
+        ));
+    }
     let truth_path = dir.join("truth.json");
     let text = std::fs::read_to_string(&truth_path)
         .map_err(|e| format!("{}: {e}", truth_path.display()))?;
@@ -183,7 +200,7 @@ pub fn score_dir(dir: &Path) -> Result<Tally, String> {
     let (mut tally, mut details) = (Tally::default(), Vec::new());
     for name in &names {
         let entry = &cases[name.as_str()];
-        let (row, ok, detail) = score(dir, name, entry)?;
+        let (row, ok, detail) = score(dir, name, entry, drop)?;
         println!("{row}");
         let hidden = truth_of_entry(entry).map_or(0, |h| h.len());
         tally.add(
