@@ -16,10 +16,14 @@
 //! hydraulic node turns into a pressure residual many times its noise on every ramp. The first
 //! kind shows itself ([`count_step`]): its increments ω_k·Δt_k are whole numbers of one
 //! encoder count 2π/N, and they jitter by whole counts about the smooth motion (the counter's
-//! rounding, whose second differences have an rms of about 0.7 of a count). A continuous
+//! rounding, whose second differences have an rms of about 0.7 of a count, a few at most,
+//! where those of a lattice of printed digits are hundreds of its steps), and a whole number
+//! of them makes a revolution. A continuous
 //! estimate's increments lie on no lattice, or, sampled from a motion as smooth as a ramp,
 //! on one without that jitter. Only a log sampled at even intervals is read as counted: where
 //! rows are missing, a logger's difference over its own interval no longer spans the row's.
+
+use std::f64::consts::PI;
 
 /// Largest departure of an interval from the mean one in an evenly sampled log (the time
 /// column's printed rounding). [1]
@@ -38,12 +42,21 @@ const LATTICE_SHARE: f64 = 0.98;
 
 /// Least rms of the increments' second differences, in counts, of a counter's rounding
 /// (about 0.7 where the rounding is uniform, more where single counts come and go at a
-/// crawl); a smoothly sampled speed's are a small fraction of its lattice's step.
+/// crawl); a smoothly sampled speed's are a small fraction of its lattice's step. [1]
 const MIN_ROUNDING_RMS: f64 = 0.2;
 
-/// Increments smaller than this share of the median moving increment are taken as equal
-/// values printed differently, not as a count.
-const PRINT_FLOOR: f64 = 1e-6;
+/// Largest rms of the increments' second differences, in counts, of a counter's rounding:
+/// a shaft at rest on a count's edge (+1, −1, +1, …) gives 4. The lattice of the printed
+/// digits or of the floating-point format, on which every logged value lies, puts the
+/// motion's own changes at hundreds of its steps and more. [1]
+const MAX_ROUNDING_RMS: f64 = 8.0;
+
+/// Largest distance of 2π over the step from a whole number of counts per revolution. [1]
+const COUNTS_PER_REV_TOLERANCE: f64 = 0.05;
+
+/// Most step sizes tried, an octave apart: from a double's rounding (1e-16 rad) to a
+/// count of a coarse encoder (0.1 rad) is 50 octaves.
+const MAX_TRIES: usize = 64;
 
 /// The shaft angle the logged `speed` integrates to from 0 at the times `t`, by the rule its
 /// kind asks for (module docs), and whether the speed is a count difference (the angle is
@@ -80,6 +93,13 @@ fn evenly_sampled(t: &[f64]) -> bool {
 
 /// The angle of one encoder count when every increment ω_k·Δt_k of the log is a whole
 /// number of it (the speed is a count difference over the row), else `None`. [rad]
+///
+/// One count is the smallest step the increments take: the smallest increment, or the
+/// smallest change between neighbours (at speed, where no increment is a single count).
+/// Where the logged angle or speed was rounded (a single-precision angle's last bit), equal
+/// counts differ by that rounding, a cluster of changes far below one count: the sizes are
+/// then tried an octave apart, upwards, and the first on whose lattice the increments lie
+/// is the count.
 pub fn count_step(increments: &[f64]) -> Option<f64> {
     let moving: Vec<f64> = increments
         .iter()
@@ -89,29 +109,41 @@ pub fn count_step(increments: &[f64]) -> Option<f64> {
     if moving.len() < MIN_MOVING_ROWS {
         return None;
     }
-    let mut sizes: Vec<f64> = moving.iter().map(|d| d.abs()).collect();
-    sizes.sort_by(f64::total_cmp);
-    let floor = PRINT_FLOOR * sizes[sizes.len() / 2];
-    // One count is the smallest step the increments take: the smallest increment, or the
-    // smallest change between neighbours (at speed, where no increment is a single count).
-    let step = moving
+    let mut steps: Vec<f64> = moving
         .iter()
         .map(|d| d.abs())
         .chain(moving.windows(2).map(|w| (w[1] - w[0]).abs()))
-        .filter(|s| *s > floor)
-        .fold(f64::INFINITY, f64::min);
-    if !step.is_finite() {
-        return None;
-    }
-    // Refined by least squares on the counts it assigns (the printed speed's rounding).
+        .filter(|s| *s > 0.0)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    // The sizes tried, each at least twice the last: one per octave through the rounding's
+    // cluster, then the count above it.
+    let mut last = 0.0;
+    steps
+        .into_iter()
+        .filter(|s| {
+            let next = *s >= 2.0 * last;
+            if next {
+                last = *s;
+            }
+            next
+        })
+        .take(MAX_TRIES)
+        .find_map(|step| on_lattice(increments, &moving, step))
+}
+
+/// The step refined by least squares on the counts `step` assigns to the `moving`
+/// increments, when they lie on its lattice with the counter's jitter (module docs).
+fn on_lattice(increments: &[f64], moving: &[f64], step: f64) -> Option<f64> {
     let counts = |step: f64| moving.iter().map(move |d| (d / step).round());
     let (num, den) = counts(step)
-        .zip(&moving)
+        .zip(moving)
         .fold((0.0, 0.0), |(num, den), (c, d)| (num + c * d, den + c * c));
     let step = if den > 0.0 { num / den } else { step };
+    // A moving increment is at least one count.
     let on = counts(step)
-        .zip(&moving)
-        .filter(|(c, d)| (*d / step - c).abs() <= LATTICE_TOLERANCE)
+        .zip(moving)
+        .filter(|(c, d)| *c != 0.0 && (*d / step - c).abs() <= LATTICE_TOLERANCE)
         .count();
     if (on as f64) < LATTICE_SHARE * moving.len() as f64 {
         return None;
@@ -124,13 +156,17 @@ pub fn count_step(increments: &[f64]) -> Option<f64> {
             let dd = (w[2] - 2.0 * w[1] + w[0]) / step;
             (sum + dd * dd, n + 1)
         });
-    (n > 0 && (sum / n as f64).sqrt() >= MIN_ROUNDING_RMS).then_some(step)
+    let rms = if n > 0 { (sum / n as f64).sqrt() } else { 0.0 };
+    // A whole number of counts per revolution: a speed printed to a few decimals lies on a
+    // lattice of 10⁻ᵈ·Δt, which divides a revolution by no whole number.
+    let per_rev = 2.0 * PI / step;
+    let whole = (per_rev - per_rev.round()).abs() <= COUNTS_PER_REV_TOLERANCE;
+    ((MIN_ROUNDING_RMS..=MAX_ROUNDING_RMS).contains(&rms) && whole).then_some(step)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     /// A shaft accelerating from rest and oscillating, θ(t) = 3·t² + 0.2·sin(40·t). [rad]
     fn motion(t: f64) -> f64 {
@@ -199,6 +235,41 @@ mod tests {
                 th[k]
             );
         }
+    }
+
+    #[test]
+    fn counts_read_from_a_single_precision_angle_are_still_counts() {
+        // A logger differencing an angle it holds in single precision: equal counts differ
+        // by the angle's last bit (5e-7 rad near 2π), far below one count of 10 000 per
+        // revolution, and the step is the count above that cluster.
+        let q = 2.0 * PI / 10_000.0;
+        let t: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
+        let theta: Vec<f64> = t
+            .iter()
+            .map(|&t| ((motion(t) / q).floor() * q).rem_euclid(2.0 * PI) as f32 as f64)
+            .collect();
+        let increments: Vec<f64> = (1..t.len())
+            .map(|k| {
+                let d = theta[k] - theta[k - 1];
+                d - 2.0 * PI * (d / (2.0 * PI)).round()
+            })
+            .collect();
+        let step = count_step(&increments).expect("a lattice");
+        assert!((step / q - 1.0).abs() < 1e-3, "{step} against {q}");
+    }
+
+    #[test]
+    fn a_speed_printed_to_two_decimals_is_not_taken_for_counts() {
+        // The speed of the motion sampled and printed to 0.01 rad/s: its increments lie on a
+        // lattice of 1e-5 rad with a rounding jitter as a counter's, but 2π/1e-5 is no whole
+        // number of counts.
+        let t: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
+        let w: Vec<f64> = t
+            .iter()
+            .map(|&t| ((6.0 * t + 8.0 * (40.0 * t).cos()) * 100.0).round() / 100.0)
+            .collect();
+        let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
+        assert_eq!(count_step(&increments), None);
     }
 
     #[test]
