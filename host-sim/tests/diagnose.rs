@@ -314,17 +314,14 @@ fn a_dead_time_is_measured_from_the_currents_alone() {
     }
 }
 
-#[test]
-fn two_effects_at_once_are_both_named() {
-    // A leaking pump on a motor with a cogging torque: the leakage shows in the pressure's
-    // relation, the cogging in the torque line at the slot order. Each judged against the
-    // model extended by the other; both named, nothing else, each within 25 %.
-    let (v, _) = diagnose(
-        "pair",
-        "pressure-step",
-        Some("extra_leakage:coefficient_m3_s_pa=5e-13,cogging_torque:amplitude_nm=0.3"),
-        &["--log-rate", "1000", "--duration", "20"],
-    );
+/// The pair of [`two_effects_at_once_are_both_named`]: a leaking pump (5e-13 m³/(s·Pa))
+/// on a motor with a cogging torque (0.3 N·m), a 20 s pressure step logged at 1 kHz.
+const PAIR: &str = "extra_leakage:coefficient_m3_s_pa=5e-13,cogging_torque:amplitude_nm=0.3";
+const PAIR_LOG: &[&str] = &["--log-rate", "1000", "--duration", "20"];
+
+/// Asserts that the diagnosis `v` of a [`PAIR`] log names both effects, nothing else, each
+/// within 25 %; returns the cogging's cause.
+fn assert_pair_named(v: &Value) -> &Value {
     let mut named: Vec<&str> = v["extended"]["effects"]
         .as_array()
         .unwrap()
@@ -333,20 +330,29 @@ fn two_effects_at_once_are_both_named() {
         .collect();
     named.sort_unstable();
     assert_eq!(named, ["cogging_torque", "extra_leakage"], "{v:#}");
-    let main = |name: &str, parameter: &str| {
+    let cause = |name: &str| {
         v["causes"]
             .as_array()
             .unwrap()
             .iter()
             .find(|c| c["effect"] == name)
-            .unwrap()["parameters"][parameter]
-            .as_f64()
             .unwrap()
     };
+    let main = |name: &str, parameter: &str| cause(name)["parameters"][parameter].as_f64().unwrap();
     let leak = main("extra_leakage", "coefficient_m3_s_pa");
     assert!((leak / 5e-13 - 1.0).abs() < 0.25, "{leak}");
     let cogging = main("cogging_torque", "amplitude_nm");
     assert!((cogging / 0.3 - 1.0).abs() < 0.25, "{cogging}");
+    cause("cogging_torque")
+}
+
+#[test]
+fn two_effects_at_once_are_both_named() {
+    // A leaking pump on a motor with a cogging torque: the leakage shows in the pressure's
+    // relation, the cogging in the torque line at the slot order. Each judged against the
+    // model extended by the other; both named, nothing else, each within 25 %.
+    let (v, _) = diagnose("pair", "pressure-step", Some(PAIR), PAIR_LOG);
+    assert_pair_named(&v);
 }
 
 #[test]
@@ -443,33 +449,12 @@ fn a_log_without_the_angle_is_read_from_its_counted_speed() {
     // A bench logging the encoder's count difference as its speed and no angle: the speed
     // sums back to the counted angle, the cogging line stays phase-locked across windows,
     // and both effects are named within 25 % as with the angle.
-    let (_, log) = simulate(
-        "counted-speed",
-        "pressure-step",
-        Some("extra_leakage:coefficient_m3_s_pa=5e-13,cogging_torque:amplitude_nm=0.3"),
-        &["--log-rate", "1000", "--duration", "20"],
-    );
+    let (_, log) = simulate("counted-speed", "pressure-step", Some(PAIR), PAIR_LOG);
     let v = diagnose_file(&with_counted_speed(&log));
-    let causes = v["causes"].as_array().unwrap();
-    let cause = |name: &str| causes.iter().find(|c| c["effect"] == name).unwrap();
-    let mut named: Vec<&str> = v["extended"]["effects"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| e.as_str().unwrap())
-        .collect();
-    named.sort_unstable();
-    assert_eq!(named, ["cogging_torque", "extra_leakage"], "{v:#}");
-    let cogging = cause("cogging_torque");
+    let cogging = assert_pair_named(&v);
     let evidence = cogging["evidence"].as_str().unwrap();
     assert!(
         evidence.contains("counted back from the speed"),
         "{evidence}"
     );
-    let amplitude = cogging["parameters"]["amplitude_nm"].as_f64().unwrap();
-    assert!((amplitude / 0.3 - 1.0).abs() < 0.25, "{amplitude}");
-    let leak = cause("extra_leakage")["parameters"]["coefficient_m3_s_pa"]
-        .as_f64()
-        .unwrap();
-    assert!((leak / 5e-13 - 1.0).abs() < 0.25, "{leak}");
 }
