@@ -17,12 +17,15 @@
 //!   short windows re-started from the logged speed (multiple shooting), so a torque error
 //!   shows as a slope within each window and never as a drift.
 //!
-//! The speed's derivative is the central difference over ±[`RATE_HALF_WIDTH_S`] of the
-//! speed the logged angle gives (or of the logged speed): one encoder count over one log
-//! interval is a speed step far larger than the current's noise.
+//! The shaft's acceleration is the quadratic Savitzky–Golay second derivative of the logged
+//! angle over ±[`SAVGOL_HALF_WIDTH_S`] (fitted at the logged times where the rows are
+//! uneven, [`super::uneven_derivative`]), or without the angle the central difference over
+//! ±[`RATE_HALF_WIDTH_S`] of the logged speed: one encoder count over one log interval is a
+//! speed step far larger than the current's noise.
 
 use crate::bench_log::BenchLog;
 use crate::diagnose::facts::{rows_spanning, LogFacts};
+use crate::diagnose::uneven_derivative::second_derivative_at_times;
 use plant_model::motor::{Motor, Phasor};
 use plant_model::pump::Pump;
 use plant_model::rig::{MotorParams, PumpParams};
@@ -207,8 +210,16 @@ impl ShaftMotion {
                     AccelFilter::SavitzkyGolay { half: m, period },
                 )
             } else {
-                let accel = central_rate(&log.t_s, &speed, h);
-                (Some(speed), accel, central)
+                // The same quadratic fit at the logged times; its response is taken as the
+                // even filter's at the median period.
+                let m = rows_spanning(SAVGOL_HALF_WIDTH_S, period, 1);
+                let accel =
+                    second_derivative_at_times(&log.t_s, &facts.theta_rad, m as f64 * period);
+                (
+                    Some(speed),
+                    accel,
+                    AccelFilter::SavitzkyGolay { half: m, period },
+                )
             }
         } else {
             let accel = central_rate(&log.t_s, &log.speed_rad_s, h);

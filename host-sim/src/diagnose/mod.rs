@@ -71,6 +71,7 @@ pub mod speed_angle;
 pub mod stick;
 #[cfg(test)]
 mod test_noise;
+pub mod uneven_derivative;
 pub mod unseen_motion;
 pub mod validation_spread;
 

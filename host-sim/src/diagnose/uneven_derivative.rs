@@ -1,0 +1,112 @@
+//! The second derivative of a signal logged at uneven times: at each row, the curvature of
+//! the quadratic fitted by least squares to the rows within a half-width in time of it.
+//! This is the Savitzky–Golay filter of [`super::mechanical::savgol_second_derivative`]
+//! (which assumes rows at one period) with the logged times in place of the row numbers;
+//! on even rows the two coincide.
+
+/// y″ at each row of `t` from the quadratic fitted to the rows within `half_width_s` of it
+/// (at least one on each side); a row with fewer than three such rows (an end) takes its
+/// neighbour's value. [unit of y per s²]
+pub fn second_derivative_at_times(t: &[f64], y: &[f64], half_width_s: f64) -> Vec<f64> {
+    let n = t.len().min(y.len());
+    let mut out: Vec<Option<f64>> = vec![None; n];
+    // The times' printed rounding must not drop a row at the window's edge.
+    let reach = half_width_s * (1.0 + 1e-9);
+    for k in 1..n.saturating_sub(1) {
+        // Every row within the half-width, and a neighbour on each side.
+        let (mut a, mut b) = (k - 1, k + 1);
+        while a > 0 && t[k] - t[a - 1] <= reach {
+            a -= 1;
+        }
+        while b + 1 < n && t[b + 1] - t[k] <= reach {
+            b += 1;
+        }
+        out[k] = curvature(&t[a..=b], &y[a..=b], t[k]);
+    }
+    // The ends (and any row without a fit) repeat the nearest fitted value.
+    let first = out.iter().flatten().next().copied().unwrap_or(0.0);
+    let mut last = first;
+    out.into_iter()
+        .map(|v| {
+            if let Some(v) = v {
+                last = v;
+            }
+            last
+        })
+        .collect()
+}
+
+/// Twice the quadratic coefficient of the least-squares quadratic through (t, y) about
+/// `t0`; `None` when the times do not fix a quadratic.
+fn curvature(t: &[f64], y: &[f64], t0: f64) -> Option<f64> {
+    // Scaled abscissae keep the normal equations well conditioned.
+    let h = t
+        .iter()
+        .map(|t| (t - t0).abs())
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let (mut s, mut r) = ([0.0; 5], [0.0; 3]);
+    for (ti, yi) in t.iter().zip(y) {
+        let u = (ti - t0) / h;
+        let mut p = 1.0;
+        for (j, sj) in s.iter_mut().enumerate() {
+            *sj += p;
+            if j < 3 {
+                r[j] += p * yi;
+            }
+            p *= u;
+        }
+    }
+    let m = [[s[0], s[1], s[2]], [s[1], s[2], s[3]], [s[2], s[3], s[4]]];
+    let det = det3(m);
+    if det.abs() <= 1e-12 * s[0].powi(3) {
+        return None;
+    }
+    let mut m2 = m;
+    for (row, rj) in m2.iter_mut().zip(r) {
+        row[2] = rj;
+    }
+    Some(2.0 * det3(m2) / det / (h * h))
+}
+
+fn det3(m: [[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::mechanical::savgol_second_derivative;
+
+    #[test]
+    fn a_parabola_logged_at_uneven_times_has_its_curvature_everywhere() {
+        // θ = 3 + 2·t + 7.5·t², θ″ = 15, at times 1 ms apart with every seventh row missing.
+        let t: Vec<f64> = (0..400)
+            .filter(|k| k % 7 != 3)
+            .map(|k| k as f64 * 1e-3)
+            .collect();
+        let y: Vec<f64> = t.iter().map(|t| 3.0 + 2.0 * t + 7.5 * t * t).collect();
+        for (k, a) in second_derivative_at_times(&t, &y, 3e-3).iter().enumerate() {
+            assert!((a - 15.0).abs() < 1e-6, "row {k}: {a}");
+        }
+    }
+
+    #[test]
+    fn on_even_rows_it_is_the_savitzky_golay_filter() {
+        let t: Vec<f64> = (0..300).map(|k| k as f64 * 1e-3).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|t| (40.0 * t).sin() + 0.3 * (7.0 * t).cos())
+            .collect();
+        let uneven = second_derivative_at_times(&t, &y, 3e-3);
+        let even = savgol_second_derivative(&y, 1e-3, 3);
+        for k in 3..297 {
+            assert!(
+                (uneven[k] - even[k]).abs() < 1e-6 * even[k].abs().max(1.0),
+                "row {k}"
+            );
+        }
+    }
+}
