@@ -255,22 +255,42 @@ impl BenchLog {
 
     /// The column of `signal` for filling, created empty if it was an absent optional one.
     pub fn column_mut(&mut self, signal: Signal) -> &mut Vec<f64> {
+        match self.field(signal) {
+            Field::Required(c) => c,
+            Field::Optional(c) => c.get_or_insert_with(Vec::new),
+        }
+    }
+
+    /// Takes the optional column of `signal` out of the log (as a bench that did not log
+    /// it would have written it); `false`, and nothing changed, for a required one.
+    pub fn remove(&mut self, signal: Signal) -> bool {
+        match self.field(signal) {
+            Field::Required(_) => false,
+            Field::Optional(c) => {
+                *c = None;
+                true
+            }
+        }
+    }
+
+    /// The field that holds `signal`.
+    fn field(&mut self, signal: Signal) -> Field<'_> {
         match signal {
-            Signal::Time => &mut self.t_s,
-            Signal::PressureRef => &mut self.p_ref_pa,
-            Signal::Pressure => &mut self.p_pa,
-            Signal::Speed => &mut self.speed_rad_s,
-            Signal::Iq => &mut self.iq_a,
-            Signal::Id => &mut self.id_a,
-            Signal::ThetaM => self.theta_m_rad.get_or_insert_with(Vec::new),
-            Signal::PistonPosition => self.x_m.get_or_insert_with(Vec::new),
-            Signal::PressureLow => self.p_low_pa.get_or_insert_with(Vec::new),
-            Signal::SpeedRef => self.speed_ref_rad_s.get_or_insert_with(Vec::new),
-            Signal::IqRef => self.iq_ref_a.get_or_insert_with(Vec::new),
-            Signal::Ud => self.ud_v.get_or_insert_with(Vec::new),
-            Signal::Uq => self.uq_v.get_or_insert_with(Vec::new),
-            Signal::Udc => self.udc_v.get_or_insert_with(Vec::new),
-            Signal::OilTemp => self.oil_temp_c.get_or_insert_with(Vec::new),
+            Signal::Time => Field::Required(&mut self.t_s),
+            Signal::PressureRef => Field::Required(&mut self.p_ref_pa),
+            Signal::Pressure => Field::Required(&mut self.p_pa),
+            Signal::Speed => Field::Required(&mut self.speed_rad_s),
+            Signal::Iq => Field::Required(&mut self.iq_a),
+            Signal::Id => Field::Required(&mut self.id_a),
+            Signal::ThetaM => Field::Optional(&mut self.theta_m_rad),
+            Signal::PistonPosition => Field::Optional(&mut self.x_m),
+            Signal::PressureLow => Field::Optional(&mut self.p_low_pa),
+            Signal::SpeedRef => Field::Optional(&mut self.speed_ref_rad_s),
+            Signal::IqRef => Field::Optional(&mut self.iq_ref_a),
+            Signal::Ud => Field::Optional(&mut self.ud_v),
+            Signal::Uq => Field::Optional(&mut self.uq_v),
+            Signal::Udc => Field::Optional(&mut self.udc_v),
+            Signal::OilTemp => Field::Optional(&mut self.oil_temp_c),
         }
     }
 
@@ -280,4 +300,10 @@ impl BenchLog {
             .into_iter()
             .filter_map(|s| self.column(s).map(|c| (s, c)))
     }
+}
+
+/// A column's field in a [`BenchLog`]: a required one, or an optional one that may be absent.
+enum Field<'a> {
+    Required(&'a mut Vec<f64>),
+    Optional(&'a mut Option<Vec<f64>>),
 }

@@ -376,3 +376,22 @@ fn a_column_let_go_passes_only_where_the_reader_names_it_unread() {
     assert_eq!((thin.len(), thin.p_ref_pa.len()), (334, 0));
     assert!(thin.check_holding(file, &[Signal::PressureRef]).is_ok());
 }
+
+#[test]
+fn an_optional_column_is_removed_and_a_required_one_is_not() {
+    // Every column of the contract's tables: the six required stay, the nine optional go,
+    // and the log then reads as one written without them.
+    let header = Signal::ALL.map(Signal::name).join(",");
+    let text = log_text(100, &header, |i| {
+        let mut v = vec![format!("{}", i as f64 * 1e-3)];
+        v.extend((1..Signal::ALL.len()).map(|_| "1".to_string()));
+        v.join(",")
+    });
+    let mut log = parse_str(&text).unwrap();
+    let required = ["t_s", "p_ref_pa", "p_pa", "speed_rad_s", "iq_a", "id_a"];
+    for s in Signal::ALL {
+        assert_eq!(log.remove(s), !required.contains(&s.name()), "{}", s.name());
+    }
+    let kept: Vec<&str> = log.columns().map(|(s, _)| s.name()).collect();
+    assert_eq!(kept, required);
+}

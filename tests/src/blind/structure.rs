@@ -15,7 +15,7 @@
 
 use super::Stream;
 use firmware::config::Config;
-use host_sim::bench_log::BenchLog;
+use host_sim::bench_log::{BenchLog, Signal};
 use plant_model::Rig;
 
 /// One log's drawn structure.
@@ -123,20 +123,7 @@ impl Structure {
 /// Takes the optional contract column `name` out of `log`; `false` when `name` is not an
 /// optional column (the required ones cannot be dropped).
 pub fn drop_column(log: &mut BenchLog, name: &str) -> bool {
-    let column = match name {
-        "theta_m_rad" => &mut log.theta_m_rad,
-        "x_m" => &mut log.x_m,
-        "p_low_pa" => &mut log.p_low_pa,
-        "speed_ref_rad_s" => &mut log.speed_ref_rad_s,
-        "iq_ref_a" => &mut log.iq_ref_a,
-        "ud_v" => &mut log.ud_v,
-        "uq_v" => &mut log.uq_v,
-        "udc_v" => &mut log.udc_v,
-        "oil_temp_c" => &mut log.oil_temp_c,
-        _ => return false,
-    };
-    *column = None;
-    true
+    Signal::from_name(name).is_some_and(|s| log.remove(s))
 }
 
 /// Draws a structure: each open part within the range a healthy rig has, the controller's
