@@ -270,8 +270,7 @@ pub fn analyse_reporting(
         shaft,
         orders,
         LineReading {
-            coherent: facts.angle_logged || facts.angle_counted,
-            absolute: facts.angle_logged,
+            angle: facts.angle,
             emf: match &cal.electrical {
                 Some(c) => EmfLines::Voltages(super::electrical::stator(&c.fitted.values)),
                 None => EmfLines::Currents,

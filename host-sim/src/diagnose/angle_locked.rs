@@ -22,6 +22,7 @@ use crate::diagnose::back_emf::{
 };
 use crate::diagnose::emf_law::{emf_law, EmfLaw, EmfLine};
 use crate::diagnose::lines::{OrderLines, WindowLines, DEAD_TIME_BANDS_A};
+use crate::diagnose::speed_angle::AngleSource;
 use plant_model::motor::Motor;
 use plant_model::Rig;
 use rustfft::num_complex::Complex64;
@@ -128,10 +129,9 @@ pub struct LineFit {
     pub dof: usize,
     /// Windows used.
     pub windows: usize,
-    /// Whether the phases were combined (the angle was logged or counted).
-    pub coherent: bool,
-    /// Whether the phases are against the true angle (the angle was logged).
-    pub absolute: bool,
+    /// Where the angle the lines were read against comes from: their phases were combined
+    /// when it is logged or counted.
+    pub angle: AngleSource,
     /// The flux harmonics' back-EMF lines fitted with the torque line.
     pub emf: EmfLines,
     /// Flux harmonics with the voltages: their voltage lines read as a back-EMF and as a
@@ -241,10 +241,8 @@ impl EmfLines {
 /// How the lines of a log are read.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LineReading {
-    /// The angle is logged or counted: the windows' phases are combined.
-    pub coherent: bool,
-    /// The angle is logged: the lines' phases are those against the true angle.
-    pub absolute: bool,
+    /// Where the log's angle comes from: logged or counted, the windows' phases are combined.
+    pub angle: AngleSource,
     /// The back-EMF lines the flux harmonics are fitted with (only with the angle).
     pub emf: EmfLines,
 }
@@ -259,7 +257,7 @@ pub fn fit_line(
     candidates: &[u32],
     reading: LineReading,
 ) -> Option<LineFit> {
-    let coherent = reading.coherent;
+    let coherent = reading.angle.combines_phases();
     let emf = match effect {
         LineEffect::FluxHarmonics if coherent => reading.emf,
         _ => EmfLines::None,
@@ -299,8 +297,7 @@ pub fn fit_line(
         lambda,
         dof,
         windows: per_window.len(),
-        coherent,
-        absolute: reading.absolute,
+        angle: reading.angle,
         emf,
         emf_law: emf_law(&emf_lines, crate::diagnose::dead_time::max_scale(rig)),
     })
@@ -344,7 +341,7 @@ pub fn line_gain(
     let gain = obs
         .iter()
         .map(|&Observation { of: o, free_d, .. }| {
-            let predicted = if !fit.coherent {
+            let predicted = if !fit.angle.combines_phases() {
                 // Only the magnitude is known: the best phase, i.e. the magnitudes compared.
                 o.line
                     * (fit.amplitude.re * o.regressor.norm() / o.line.norm().max(f64::MIN_POSITIVE))
@@ -384,13 +381,13 @@ pub const OFFSET_HYPOTHESES: [(&str, f64, f64); 5] = [
 pub const UNSEEN_ARRANGEMENT: usize = 3;
 
 /// The offset (signed, A) and its hypothesis from the torque line's complex amplitude `a`
-/// (coherent: phase against the electrical angle p_n·θ_m). Without a phase the arrangement
-/// cannot be seen and [`UNSEEN_ARRANGEMENT`] is read, with a positive sign.
+/// (`absolute`: its phase against the true electrical angle p_n·θ_m). Without that phase
+/// the arrangement cannot be seen and [`UNSEEN_ARRANGEMENT`] is read, with a positive sign.
 ///
 /// The image (α, β) = m·off·(cos φ, sin φ) appears in the measured q current as
 /// m·off·sin(φ − θ_e), i.e. the line K_t·m·off·j·e^{−jφ} against e^{jθ_e}.
-pub fn offset_from_line(a: Complex64, kt: f64, coherent: bool) -> (f64, &'static str) {
-    if !coherent {
+pub fn offset_from_line(a: Complex64, kt: f64, absolute: bool) -> (f64, &'static str) {
+    if !absolute {
         let (label, _, m) = OFFSET_HYPOTHESES[UNSEEN_ARRANGEMENT];
         return (a.norm() / (kt * m), label);
     }

@@ -36,6 +36,7 @@ use crate::diagnose::hydraulic_relation::hyd;
 use crate::diagnose::least_squares::ParamSpec;
 use crate::diagnose::lines::WindowLines;
 use crate::diagnose::mechanical_relation::mech;
+use crate::diagnose::speed_angle::AngleSource;
 use crate::diagnose::validation_spread::{validation_spread, VALIDATION_TOLERANCE};
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::Rig;
@@ -465,11 +466,11 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
     let order = f.effect.order(rig);
     let (parameters, floor, what) = match f.effect {
         LineEffect::CurrentOffset => {
-            let (off, label) = offset_from_line(f.amplitude, kt, f.absolute);
+            let (off, label) = offset_from_line(f.amplitude, kt, f.angle.is_logged());
             let per_nm = off.abs() / a.max(f64::MIN_POSITIVE);
             // Without the angle the line's phase cannot tell the sensor arrangement: the
             // same line is a larger offset behind a three-sensor Clarke transform.
-            let other = if f.absolute {
+            let other = if f.angle.is_logged() {
                 String::new()
             } else {
                 let three = OFFSET_HYPOTHESES[0];
@@ -530,10 +531,10 @@ fn line_verdict(f: LineFit, validation_gain: Option<f64>, rig: &Rig, kt: f64) ->
         "unexplained torque line at order {order}{with_emf} over {} steady window(s){}: {what}; \
          Λ = {:.1} ({} degrees of freedom){law}",
         f.windows,
-        match (f.absolute, f.coherent) {
-            (true, _) => ", phase-locked to the logged angle",
-            (false, true) => ", phase-locked to the angle counted back from the speed",
-            _ => "",
+        match f.angle {
+            AngleSource::Logged => ", phase-locked to the logged angle",
+            AngleSource::Counted => ", phase-locked to the angle counted back from the speed",
+            AngleSource::Integrated => "",
         },
         f.lambda,
         f.dof

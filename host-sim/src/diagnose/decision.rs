@@ -178,8 +178,7 @@ mod tests {
             lambda: 2462.0,
             dof: 4,
             windows: 2,
-            coherent: true,
-            absolute: true,
+            angle: crate::diagnose::speed_angle::AngleSource::Logged,
             emf: EmfLines::Voltages(Stator {
                 r_s_ohm: 1.15,
                 l_d_h: 5.5e-3,

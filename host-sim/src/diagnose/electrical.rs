@@ -78,7 +78,7 @@ impl<'a> ElectricalRelation<'a> {
         facts: &'a LogFacts,
         rig: &'a Rig,
     ) -> Option<ElectricalRelation<'a>> {
-        if log.ud_v.is_none() || log.uq_v.is_none() || !facts.angle_logged {
+        if log.ud_v.is_none() || log.uq_v.is_none() || !facts.angle.is_logged() {
             return None;
         }
         let u_dc_v = log.udc_v.as_deref().map_or(rig.inverter.u_dc_v, |u| {

@@ -9,7 +9,7 @@
 
 use crate::bench_log::{BenchLog, Signal};
 pub use crate::diagnose::low_side::LowSide;
-use crate::diagnose::speed_angle::integrated_angle;
+use crate::diagnose::speed_angle::{integrated_angle, AngleSource};
 use crate::diagnose::{low_side, unseen_motion};
 use plant_model::Rig;
 use std::f64::consts::PI;
@@ -81,13 +81,9 @@ pub struct LogFacts {
     pub uniform: bool,
     /// Shaft angle, unwrapped: the logged one or the logged speed integrated. [rad]
     pub theta_rad: Vec<f64>,
-    /// Whether `theta_rad` was logged (else integrated, so its absolute phase is unknown).
-    pub angle_logged: bool,
-    /// Whether `theta_rad`, not logged, is the encoder's counted angle integrated back from
-    /// a count-difference speed ([`crate::diagnose::speed_angle`]): exact but for its
-    /// unknown start, so the lines' phases combine across windows though their absolute
-    /// phase is unknown.
-    pub angle_counted: bool,
+    /// Where `theta_rad` comes from: logged, or integrated from the logged speed
+    /// ([`crate::diagnose::speed_angle`]), so that its absolute phase is unknown.
+    pub angle: AngleSource,
     /// The rig's fill pressure, the low side's (port B) where the log does not hold it
     /// ([`LogFacts::p_low`]). [Pa]
     pub fill_low_pa: f64,
@@ -143,15 +139,10 @@ impl LogFacts {
         let rows = log.len();
         let t = &log.t_s;
         let period_s = median_period(t);
-        let uniform = t
-            .windows(2)
-            .all(|w| ((w[1] - w[0]) / period_s - 1.0).abs() < 0.01);
-        let (theta_rad, angle_logged, angle_counted) = match log.theta_m_rad.as_deref() {
-            Some(th) => (unwrap_angle(th), true, false),
-            None => {
-                let (theta, counted) = integrated_angle(t, &log.speed_rad_s);
-                (theta, false, counted)
-            }
+        let uniform = evenly_sampled(t, period_s);
+        let (theta_rad, angle) = match log.theta_m_rad.as_deref() {
+            Some(th) => (unwrap_angle(th), AngleSource::Logged),
+            None => integrated_angle(t, &log.speed_rad_s, uniform),
         };
         let fill_low_pa = rig.fill.pressure_pa;
         let p_low = LowSide::of(log, fill_low_pa);
@@ -216,8 +207,7 @@ impl LogFacts {
             period_s,
             uniform,
             theta_rad,
-            angle_logged,
-            angle_counted,
+            angle,
             fill_low_pa,
             fill_pa,
             low_side_apart,
@@ -363,8 +353,14 @@ pub fn savitzky_golay_smooth(y: &[f64], m: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Whether every sampling interval of `t` is within 1 % of `period_s` (its median).
+pub fn evenly_sampled(t: &[f64], period_s: f64) -> bool {
+    t.windows(2)
+        .all(|w| ((w[1] - w[0]) / period_s - 1.0).abs() < 0.01)
+}
+
 /// Median of the sampling intervals of `t` (at least two rows). [s]
-fn median_period(t: &[f64]) -> f64 {
+pub fn median_period(t: &[f64]) -> f64 {
     let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
     d.sort_by(f64::total_cmp);
     d.get(d.len() / 2)

@@ -283,7 +283,7 @@ pub fn window_lines(
             }
             // The inverter's dead-time voltage the logged currents make, per fade band
             // ([`dead_time_voltage`]): only where the angle places the phases.
-            let dead_time = if facts.angle_logged {
+            let dead_time = if facts.angle.is_logged() {
                 dead_time_voltage(log, facts, rig, rows.clone())
             } else {
                 Vec::new()

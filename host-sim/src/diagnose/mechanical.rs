@@ -199,28 +199,21 @@ impl ShaftMotion {
         let h = rows_spanning(RATE_HALF_WIDTH_S, facts.period_s, 1);
         let period = facts.period_s;
         let central = AccelFilter::Central { half: h, period };
-        let (speed, accel, accel_filter) = if facts.angle_logged {
+        let (speed, accel, accel_filter) = if facts.angle.is_logged() {
             let speed = central_rate(&log.t_s, &facts.theta_rad, h);
-            if facts.uniform {
-                let m = rows_spanning(SAVGOL_HALF_WIDTH_S, period, 1);
-                let accel = savgol_second_derivative(&facts.theta_rad, period, m);
-                (
-                    Some(speed),
-                    accel,
-                    AccelFilter::SavitzkyGolay { half: m, period },
-                )
+            let m = rows_spanning(SAVGOL_HALF_WIDTH_S, period, 1);
+            // Uneven rows: the same quadratic fitted at the logged times, its response taken
+            // as the even filter's at the median period.
+            let accel = if facts.uniform {
+                savgol_second_derivative(&facts.theta_rad, period, m)
             } else {
-                // The same quadratic fit at the logged times; its response is taken as the
-                // even filter's at the median period.
-                let m = rows_spanning(SAVGOL_HALF_WIDTH_S, period, 1);
-                let accel =
-                    second_derivative_at_times(&log.t_s, &facts.theta_rad, m as f64 * period);
-                (
-                    Some(speed),
-                    accel,
-                    AccelFilter::SavitzkyGolay { half: m, period },
-                )
-            }
+                second_derivative_at_times(&log.t_s, &facts.theta_rad, m as f64 * period)
+            };
+            (
+                Some(speed),
+                accel,
+                AccelFilter::SavitzkyGolay { half: m, period },
+            )
         } else {
             let accel = central_rate(&log.t_s, &log.speed_rad_s, h);
             (None, accel, central)

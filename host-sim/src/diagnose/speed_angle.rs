@@ -25,9 +25,31 @@
 
 use std::f64::consts::PI;
 
-/// Largest departure of an interval from the mean one in an evenly sampled log (the time
-/// column's printed rounding). [1]
-const EVEN_SPREAD: f64 = 0.01;
+/// Where a log's shaft angle comes from, and so how far the phases of the lines read
+/// against it can be trusted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AngleSource {
+    /// Logged (`theta_m_rad`): the lines' phases are against the true angle.
+    Logged,
+    /// Counted back from a count-difference speed: exact but for its unknown start, so the
+    /// lines' phases combine across windows, but their absolute phase is unknown.
+    Counted,
+    /// Integrated from a sampled speed by trapezoids: it drifts, and only the lines'
+    /// magnitudes are read.
+    Integrated,
+}
+
+impl AngleSource {
+    /// Whether the lines' phases combine across windows (the angle is logged or counted).
+    pub fn combines_phases(self) -> bool {
+        matches!(self, AngleSource::Logged | AngleSource::Counted)
+    }
+
+    /// Whether the lines' phases are against the true angle.
+    pub fn is_logged(self) -> bool {
+        self == AngleSource::Logged
+    }
+}
 
 /// Fewest moving rows from which the counts' lattice is read.
 const MIN_MOVING_ROWS: usize = 50;
@@ -59,12 +81,12 @@ const COUNTS_PER_REV_TOLERANCE: f64 = 0.05;
 const MAX_TRIES: usize = 64;
 
 /// The shaft angle the logged `speed` integrates to from 0 at the times `t`, by the rule its
-/// kind asks for (module docs), and whether the speed is a count difference (the angle is
-/// then the counted one, up to the counter's value at the first row). [rad]
-pub fn integrated_angle(t: &[f64], speed: &[f64]) -> (Vec<f64>, bool) {
+/// kind asks for (module docs), and which kind it was. Only an `evenly_sampled` log (the
+/// facts' test) is read as counted. [rad]
+pub fn integrated_angle(t: &[f64], speed: &[f64], evenly_sampled: bool) -> (Vec<f64>, AngleSource) {
     let n = t.len().min(speed.len());
     let increments: Vec<f64> = (1..n).map(|k| speed[k] * (t[k] - t[k - 1])).collect();
-    let counted = evenly_sampled(&t[..n]) && count_step(&increments).is_some();
+    let counted = evenly_sampled && count_step(&increments).is_some();
     let mut theta = Vec::with_capacity(n);
     let mut acc = 0.0;
     for k in 0..n {
@@ -77,18 +99,12 @@ pub fn integrated_angle(t: &[f64], speed: &[f64]) -> (Vec<f64>, bool) {
         }
         theta.push(acc);
     }
-    (theta, counted)
-}
-
-/// Whether every interval of `t` is within [`EVEN_SPREAD`] of the mean interval.
-fn evenly_sampled(t: &[f64]) -> bool {
-    let n = t.len();
-    if n < 2 {
-        return false;
-    }
-    let mean = (t[n - 1] - t[0]) / (n - 1) as f64;
-    t.windows(2)
-        .all(|w| ((w[1] - w[0]) / mean - 1.0).abs() <= EVEN_SPREAD)
+    let source = if counted {
+        AngleSource::Counted
+    } else {
+        AngleSource::Integrated
+    };
+    (theta, source)
 }
 
 /// The angle of one encoder count when every increment ω_k·Δt_k of the log is a whole
@@ -100,7 +116,7 @@ fn evenly_sampled(t: &[f64]) -> bool {
 /// counts differ by that rounding, a cluster of changes far below one count: the sizes are
 /// then tried an octave apart, upwards, and the first on whose lattice the increments lie
 /// is the count.
-pub fn count_step(increments: &[f64]) -> Option<f64> {
+fn count_step(increments: &[f64]) -> Option<f64> {
     let moving: Vec<f64> = increments
         .iter()
         .copied()
@@ -167,6 +183,7 @@ fn on_lattice(increments: &[f64], moving: &[f64], step: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::facts::{evenly_sampled, median_period};
 
     /// A shaft accelerating from rest and oscillating, θ(t) = 3·t² + 0.2·sin(40·t). [rad]
     fn motion(t: f64) -> f64 {
@@ -178,7 +195,7 @@ mod tests {
         // A ramp 0 → 20 rad/s over 1 s turns ½·20·1 = 10 rad (trapezoids are exact on a ramp).
         let t: Vec<f64> = (0..1001).map(|k| k as f64 * 1e-3).collect();
         let w: Vec<f64> = t.iter().map(|&t| 20.0 * t).collect();
-        let (th, _) = integrated_angle(&t, &w);
+        let (th, _) = integrated_angle(&t, &w, true);
         assert!((th[1000] - 10.0).abs() < 1e-9, "{}", th[1000]);
     }
 
@@ -203,7 +220,7 @@ mod tests {
         let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
         let step = count_step(&increments).expect("a lattice");
         assert!((step / q - 1.0).abs() < 1e-4, "{step} against {q}");
-        let (th, _) = integrated_angle(&t, &w);
+        let (th, _) = integrated_angle(&t, &w, true);
         for k in (0..t.len()).step_by(97) {
             let counted = (counts[k] - counts[0]) * q;
             assert!(
@@ -225,7 +242,7 @@ mod tests {
             .collect();
         let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
         assert_eq!(count_step(&increments), None);
-        let (th, _) = integrated_angle(&t, &w);
+        let (th, _) = integrated_angle(&t, &w, true);
         let bound = 4.0 * 1e-6 / 12.0 * 0.2 * 40.0f64.powi(3);
         for k in (0..t.len()).step_by(97) {
             let truth = motion(t[k]) - motion(0.0);
@@ -291,14 +308,13 @@ mod tests {
                 }
             })
             .collect();
-        let (_, counted) = integrated_angle(&t, &w);
-        assert!(!counted);
-        let (_, counted) = integrated_angle(&all, &{
-            let mut w = vec![0.0];
-            w.extend((1..all.len()).map(|k| (counts[k] - counts[k - 1]) * q / 1e-3));
-            w
-        });
-        assert!(counted);
+        let even = |t: &[f64]| evenly_sampled(t, median_period(t));
+        let (_, source) = integrated_angle(&t, &w, even(&t));
+        assert_eq!(source, AngleSource::Integrated);
+        let mut w = vec![0.0];
+        w.extend((1..all.len()).map(|k| (counts[k] - counts[k - 1]) * q / 1e-3));
+        let (_, source) = integrated_angle(&all, &w, even(&all));
+        assert_eq!(source, AngleSource::Counted);
     }
 
     #[test]

@@ -4,6 +4,8 @@
 //! (which assumes rows at one period) with the logged times in place of the row numbers;
 //! on even rows the two coincide.
 
+use nalgebra::{Matrix3, Vector3};
+
 /// y″ at each row of `t` from the quadratic fitted to the rows within `half_width_s` of it
 /// (at least one on each side); a row with fewer than three such rows (an end) takes its
 /// neighbour's value. [unit of y per s²]
@@ -45,34 +47,16 @@ fn curvature(t: &[f64], y: &[f64], t0: f64) -> Option<f64> {
         .map(|t| (t - t0).abs())
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
-    let (mut s, mut r) = ([0.0; 5], [0.0; 3]);
+    let mut normal = Matrix3::zeros();
+    let mut rhs = Vector3::zeros();
     for (ti, yi) in t.iter().zip(y) {
         let u = (ti - t0) / h;
-        let mut p = 1.0;
-        for (j, sj) in s.iter_mut().enumerate() {
-            *sj += p;
-            if j < 3 {
-                r[j] += p * yi;
-            }
-            p *= u;
-        }
+        let row = Vector3::new(1.0, u, u * u);
+        normal += row * row.transpose();
+        rhs += row * *yi;
     }
-    let m = [[s[0], s[1], s[2]], [s[1], s[2], s[3]], [s[2], s[3], s[4]]];
-    let det = det3(m);
-    if det.abs() <= 1e-12 * s[0].powi(3) {
-        return None;
-    }
-    let mut m2 = m;
-    for (row, rj) in m2.iter_mut().zip(r) {
-        row[2] = rj;
-    }
-    Some(2.0 * det3(m2) / det / (h * h))
-}
-
-fn det3(m: [[f64; 3]; 3]) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    let c = normal.lu().solve(&rhs)?;
+    Some(2.0 * c[2] / (h * h))
 }
 
 #[cfg(test)]
