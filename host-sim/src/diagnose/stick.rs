@@ -21,6 +21,14 @@
 //! difference of an oscillating payload is not; the median ignores the breakaway
 //! transients.
 //!
+//! The window is at least as long as a piston creeping at [`CREEP_SPEED_M_S`] takes to
+//! cross the band: on a noisy transducer (σ_x ≈ 1 µm makes the band ~6 µm) a steady stroke
+//! at a few tenths of a millimetre a second stays within the band over the velocity's
+//! short span, and a short window would read most of its rows as rests and every noise
+//! excursion as a breakaway. A longer look-back does not delay a breakaway (the row that
+//! leaves the band of the resting rows before it is seen moving at once); it only keeps a
+//! rest shorter than the window from being seen.
+//!
 //! The test's cost on a noisy transducer: a piston creeping by less than the band reads as
 //! resting, so a breakaway is seen when the motion has grown past it, and the force the
 //! piston is seen to break away at is the force then. A sliding row read as resting
@@ -37,6 +45,13 @@ pub const STICK_NOISE_MULTIPLE: f64 = 4.0;
 /// simulator's): far below any transducer's resolution, far above the rounding of a
 /// position written in full precision. [m]
 pub const STICK_FLOOR_M: f64 = 1e-9;
+
+/// The slowest motion a resting window must tell from a rest: the speed over which the
+/// cylinder relation's Coulomb force has faded in (sliding, not stuck). [m/s]
+pub const CREEP_SPEED_M_S: f64 = 1e-4;
+
+/// Longest rest window, whatever the transducer's noise and the log's rate. [rows]
+const MAX_WINDOW_ROWS: usize = 10_000;
 
 /// Relative rounding of a count scaled to metres and printed in decimal (~1e-12), with a
 /// wide margin: steps this close to a whole multiple of the smallest are counts. [1]
@@ -67,12 +82,20 @@ pub struct Stick {
 }
 
 impl Stick {
-    /// The stick phases of the logged position `x` [m], a row resting when the position
-    /// stayed within the band over the `window` rows before it.
-    pub fn of(x: &[f64], window: usize) -> Stick {
+    /// The stick phases of the logged position `x` [m] sampled every `period_s` [s], a row
+    /// resting when the position stayed within the band over the `window` rows before it,
+    /// or over the rows a piston creeping at [`CREEP_SPEED_M_S`] takes to cross the band
+    /// where that is longer.
+    pub fn of(x: &[f64], window: usize, period_s: f64) -> Stick {
         let threshold_m = (STICK_NOISE_MULTIPLE * std::f64::consts::SQRT_2 * position_noise(x))
             .max(quantisation_step(x) * (1.0 + COUNT_ROUNDING))
             .max(STICK_FLOOR_M);
+        let creep = (threshold_m / (CREEP_SPEED_M_S * period_s)).ceil();
+        let window = if creep.is_finite() && creep > window as f64 {
+            (creep as usize).min(MAX_WINDOW_ROWS)
+        } else {
+            window
+        };
         let n = x.len();
         let rests: Vec<bool> = (0..n)
             .map(|k| {
@@ -207,7 +230,7 @@ mod tests {
                 }
             })
             .collect();
-        let s = Stick::of(&x, REST_ROWS);
+        let s = Stick::of(&x, REST_ROWS, 1e-3);
         assert!(s.rests[..10].iter().all(|r| !*r) && s.rests[10..100].iter().all(|r| *r));
         assert!(s.rests[100..].iter().all(|r| !*r));
         assert_eq!(s.breakaways, vec![Breakaway { row: 99, dir: 1.0 }]);
@@ -231,7 +254,7 @@ mod tests {
                 (exact / q).round() * q
             })
             .collect();
-        let s = Stick::of(&x, REST_ROWS);
+        let s = Stick::of(&x, REST_ROWS, 1e-3);
         // The swing's rounding reads as noise of a fraction of a count: the band is at
         // least a count and at most a few.
         assert!(
@@ -240,7 +263,42 @@ mod tests {
             s.threshold_m
         );
         assert!(s.rests[20..2000].iter().all(|r| !*r));
-        assert!(s.rests[2010..].iter().all(|r| *r));
+        // The rest is read once a piston creeping at 0.1 mm/s would have left the band: at
+        // most 5 µm / 0.1 mm/s = 50 rows after it began.
+        assert!(s.rests[2050..].iter().all(|r| *r));
         assert!(s.breakaways.is_empty(), "{:?}", s.breakaways);
+    }
+
+    #[test]
+    fn a_slow_stroke_on_a_noisy_transducer_at_a_low_rate_is_no_string_of_sticks() {
+        // 250 Hz, 1 µm counts over 1 µm of white noise (the band is about 4·√2 µm): 2 s at
+        // rest, then a stroke at 0.3 mm/s, 1.2 µm a row, which stays within the band over
+        // the velocity's few rows but not over the time a 0.1 mm/s creep takes to cross it.
+        let (q, period, start) = (1e-6, 4e-3, 500);
+        let x: Vec<f64> = gaussian(5500, 11)
+            .iter()
+            .enumerate()
+            .map(|(k, n)| {
+                let moved = 3e-4 * period * k.saturating_sub(start) as f64;
+                ((2e-3 + moved + 1e-6 * n) / q).round() * q
+            })
+            .collect();
+        let s = Stick::of(&x, 2, period);
+        let band = s.threshold_m;
+        assert!(band > 4e-6 && band < 8e-6, "{band}");
+        // Sliding rows read as rests: none once the motion has crossed the band.
+        let crossed = start + (band / (3e-4 * period)).ceil() as usize;
+        let still = s.rests[crossed..].iter().filter(|r| **r).count();
+        assert_eq!(still, 0, "{still} sliding rows read as rests");
+        // One breakaway, where the motion leaves the resting rows' band.
+        assert_eq!(s.breakaways.len(), 1, "{:?}", s.breakaways);
+        let b = s.breakaways[0];
+        assert!(
+            b.dir > 0.0 && b.row + 1 >= start && b.row < crossed,
+            "{b:?}"
+        );
+        // Rests between the first window and the start are read as rests.
+        let rested = s.rests[100..start].iter().filter(|r| **r).count();
+        assert!(rested >= 390, "{rested} of 400 resting rows");
     }
 }

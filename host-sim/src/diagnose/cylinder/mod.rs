@@ -143,7 +143,7 @@ impl<'a> CylinderRelation<'a> {
             x,
             v,
             a,
-            stick: Stick::of(x, 2 * h),
+            stick: Stick::of(x, 2 * h, facts.period_s),
         })
     }
 
