@@ -24,16 +24,20 @@ use std::hint::black_box;
 /// PWM periods in 0.1 s at 20 kHz.
 const PERIODS: usize = 2000;
 
-/// The settled loop of the pressure hold with the paper's low-speed effects.
-fn settled() -> ClosedLoop {
-    let controller = Rig::nominal();
-    let mut plant = controller.clone();
+/// The nominal rig with the paper's low-speed effects on: the plant the loop runs.
+fn plant_rig() -> Rig {
+    let mut plant = Rig::nominal();
     for e in paper_low_speed_effects() {
         e.apply(&mut plant);
     }
+    plant
+}
+
+/// The settled loop of the pressure hold with the paper's low-speed effects.
+fn settled() -> ClosedLoop {
     let scenario = by_name("pressure-hold").expect("scenario");
-    let config = controller_config(&controller);
-    let mut cl = ClosedLoop::new(&plant, &config, scenario, 1).expect("valid rig");
+    let config = controller_config(&Rig::nominal());
+    let mut cl = ClosedLoop::new(&plant_rig(), &config, scenario, 1).expect("valid rig");
     // Settle into the holding state first.
     cl.run(0.5, 1000, |_| {});
     cl
@@ -69,10 +73,6 @@ fn parts(c: &mut Criterion) {
         let (d, on) = (s.outputs.duties, s.outputs.pwm_enabled);
         duties.push(([d[0] as f64, d[1] as f64, d[2] as f64], on));
     }
-    let mut effects = Rig::nominal();
-    for e in paper_low_speed_effects() {
-        e.apply(&mut effects);
-    }
     let opt = RunOptions {
         duration_s: 0.1,
         log_rate_hz: LOG_RATE_HZ,
@@ -83,7 +83,7 @@ fn parts(c: &mut Criterion) {
         integrator: Integrator::default(),
     };
     let scenario = by_name("pressure-hold").expect("scenario");
-    let log = run(&effects, &Rig::nominal(), scenario, &opt)
+    let log = run(&plant_rig(), &Rig::nominal(), scenario, &opt)
         .expect("run")
         .log;
     let period = cl.period_s();

@@ -403,44 +403,21 @@ fn a_leakage_is_measured_in_absolute_terms_on_a_pump_built_off_its_displacement(
 /// encoder angle's difference over each row, (θ_k − θ_{k−1})/(t_k − t_{k−1}), and the
 /// angle column dropped.
 fn with_counted_speed(log: &std::path::Path) -> PathBuf {
-    let text = fs::read_to_string(log).unwrap();
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let (t_col, w_col, th_col) = (col("t_s"), col("speed_rad_s"), col("theta_m_rad"));
-    let mut out: String = text
-        .lines()
-        .filter(|l| l.starts_with('#'))
-        .map(|l| format!("{l}\n"))
-        .collect();
-    let keep = |cells: &[&str]| -> Vec<String> {
-        (0..cells.len())
-            .filter(|&i| i != th_col)
-            .map(|i| cells[i].to_string())
-            .collect()
-    };
-    out += &(keep(&header).join(",") + "\n");
-    let mut last: Option<(f64, f64)> = None;
-    for line in lines {
-        let cells: Vec<&str> = line.split(',').collect();
-        let (t, th): (f64, f64) = (
-            cells[t_col].parse().unwrap(),
-            cells[th_col].parse().unwrap(),
-        );
-        let speed = match last {
-            Some((t0, th0)) => {
-                let d = th - th0;
-                (d - std::f64::consts::TAU * (d / std::f64::consts::TAU).round()) / (t - t0)
+    use host_sim::bench_log;
+    use std::f64::consts::TAU;
+    let mut b = bench_log::read(log).unwrap();
+    let theta = b.theta_m_rad.take().unwrap();
+    b.speed_rad_s = (0..b.len())
+        .map(|k| {
+            if k == 0 {
+                return 0.0;
             }
-            None => 0.0,
-        };
-        last = Some((t, th));
-        let mut row = keep(&cells);
-        row[if w_col < th_col { w_col } else { w_col - 1 }] = format!("{speed}");
-        out += &(row.join(",") + "\n");
-    }
+            let d = theta[k] - theta[k - 1];
+            (d - TAU * (d / TAU).round()) / (b.t_s[k] - b.t_s[k - 1])
+        })
+        .collect();
     let path = log.with_file_name("counted.csv");
-    fs::write(&path, out).unwrap();
+    bench_log::write(&path, &b).unwrap();
     path
 }
 

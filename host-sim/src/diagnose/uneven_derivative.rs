@@ -62,7 +62,6 @@ fn curvature(t: &[f64], y: &[f64], t0: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::mechanical::savgol_second_derivative;
 
     #[test]
     fn a_parabola_logged_at_uneven_times_has_its_curvature_everywhere() {
@@ -78,18 +77,27 @@ mod tests {
     }
 
     #[test]
-    fn on_even_rows_it_is_the_savitzky_golay_filter() {
-        let t: Vec<f64> = (0..300).map(|k| k as f64 * 1e-3).collect();
-        let y: Vec<f64> = t
-            .iter()
-            .map(|t| (40.0 * t).sin() + 0.3 * (7.0 * t).cos())
-            .collect();
-        let uneven = second_derivative_at_times(&t, &y, 3e-3);
-        let even = savgol_second_derivative(&y, 1e-3, 3);
+    fn on_even_rows_a_sinusoid_comes_out_with_the_quadratic_fits_gain() {
+        // y = sin(ω·t) on rows 1 ms apart, fitted over ±3 rows. On a symmetric window the
+        // least-squares quadratic's coefficient is Σ c_j·y_j / Σ c_j² with c_j = j² − ⟨j²⟩
+        // (orthogonal to 1 and j), so the curvature at row k is
+        // sin(ω·t_k) · 2·Σ c_j·cos(ω·j·T) / (Σ c_j²·T²): the exact −ω² scaled by the fit's gain.
+        let (w, period, m) = (40.0, 1e-3, 3i32);
+        let t: Vec<f64> = (0..300).map(|k| k as f64 * period).collect();
+        let y: Vec<f64> = t.iter().map(|t| (w * t).sin()).collect();
+        let mean_j2 = (m * (m + 1)) as f64 / 3.0;
+        let c = |j: i32| (j * j) as f64 - mean_j2;
+        let num: f64 = (-m..=m).map(|j| c(j) * (w * j as f64 * period).cos()).sum();
+        let den: f64 = (-m..=m).map(|j| c(j) * c(j)).sum::<f64>() * period * period;
+        let gain = 2.0 * num / den;
+        assert!((gain / -(w * w) - 1.0).abs() < 0.01, "{gain}");
+        let a = second_derivative_at_times(&t, &y, m as f64 * period);
         for k in 3..297 {
+            let exact = (w * t[k]).sin() * gain;
             assert!(
-                (uneven[k] - even[k]).abs() < 1e-6 * even[k].abs().max(1.0),
-                "row {k}"
+                (a[k] - exact).abs() < 1e-6 * w * w,
+                "row {k}: {} vs {exact}",
+                a[k]
             );
         }
     }

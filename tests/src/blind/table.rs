@@ -11,7 +11,7 @@
 
 use super::judge::{failures, main_parameter, read_said, truth_of_entry, Named, Said, Standard};
 use super::structure::drop_column;
-use host_sim::bench_log::{self, BenchLog};
+use host_sim::bench_log::{self, Signal};
 use host_sim::diagnose::diagnose;
 use plant_model::Rig;
 use serde_json::Value;
@@ -172,8 +172,8 @@ fn score(
 /// `test` counts under `—`). Each log is read without the optional columns `drop` (a bench
 /// that did not log them); a name that is not an optional column is an error.
 pub fn score_dir(dir: &Path, drop: &[&str]) -> Result<Tally, String> {
-    let mut probe = BenchLog::default();
-    if let Some(bad) = drop.iter().find(|c| !drop_column(&mut probe, c)) {
+    let optional = |c: &str| Signal::from_name(c).is_some_and(|s| !s.is_required());
+    if let Some(bad) = drop.iter().find(|c| !optional(c)) {
         return Err(format!(
             "cannot drop `{bad}`: not an optional column of the bench-log contract"
         ));
