@@ -252,7 +252,7 @@ pub fn analyse_reporting(
     let lines = window_lines(log, &facts, rig, orders, shaft.kt, shaft.j, shaft.d_per_rad);
     let (line_id, line_val): (Vec<_>, Vec<_>) = lines
         .iter()
-        .partition(|w| w.window.rows.start < facts.split);
+        .partition(|w| w.window.rows.start < facts.lines_split);
     progress.step("testing effects");
     // 4. Every effect tested; beside the tests, the baseline the report predicts with,
     // driven on from the screening's calibration (it depends on nothing they find).

@@ -10,10 +10,10 @@
 use crate::bench_log::{BenchLog, Signal};
 pub use crate::diagnose::low_side::LowSide;
 use crate::diagnose::speed_angle::{integrated_angle, AngleSource};
-use crate::diagnose::{low_side, unseen_motion};
+use crate::diagnose::{line_split, low_side, unseen_motion};
 use plant_model::Rig;
 use std::f64::consts::PI;
-use std::ops::Range;
+use std::ops::{Range, RangeInclusive};
 
 /// Piston travel above which the log shows the piston moving (well above a linear
 /// transducer's noise, well below the slowest stroke's travel). [m]
@@ -120,8 +120,12 @@ pub struct LogFacts {
     /// Noise RMS per logged signal, from the trimmed second differences. [unit]
     pub noise_rms: Vec<(Signal, f64)>,
     /// Steady-rotation windows (speed nearly constant, at least
-    /// [`STEADY_MIN_REVOLUTIONS`]), in time order, none across the segments' boundary.
+    /// [`STEADY_MIN_REVOLUTIONS`]), in time order, none across the lines' boundary.
     pub steady: Vec<SteadyWindow>,
+    /// First row of the steady windows the line effects are checked on (those before it are
+    /// fitted): the segments' boundary unless the slow rotation lies on one side of it
+    /// ([`line_split::divided_windows`]).
+    pub lines_split: usize,
 }
 
 impl LogFacts {
@@ -190,18 +194,8 @@ impl LogFacts {
             }
             None => rig.fill.pressure_pa - rig.fill.check_cracking_pa,
         };
-        let mut steady = steady_windows(&t[..split], &theta_rad[..split], period_s)
-            .into_iter()
-            .filter(|w| w.rows.start >= start)
-            .collect::<Vec<_>>();
-        steady.extend(
-            steady_windows(&t[split..], &theta_rad[split..], period_s)
-                .into_iter()
-                .map(|mut w| {
-                    w.rows = w.rows.start + split..w.rows.end + split;
-                    w
-                }),
-        );
+        let (steady, lines_split) =
+            line_split::divided_windows(t, &theta_rad, period_s, rig, split, start);
         LogFacts {
             rows,
             period_s,
@@ -219,6 +213,7 @@ impl LogFacts {
             start,
             noise_rms,
             steady,
+            lines_split,
         }
     }
 
@@ -272,46 +267,66 @@ fn segment_split(t: &[f64], theta: &[f64], period_s: f64, rig: &Rig) -> usize {
         let t_f = t[0] + f * (t[rows - 1] - t[0]);
         t.partition_point(|x| *x < t_f).clamp(1, rows - 1)
     };
-    let highest = rig
-        .motor
-        .cogging_fundamental_order()
-        .max(6 * rig.motor.pole_pairs) as f64;
-    let limit = 2.0 * PI / period_s / 3.0 / highest;
+    let limit = slow_line_speed(period_s, rig);
     let slow: Vec<SteadyWindow> = steady_windows(t, theta, period_s)
         .into_iter()
         .filter(|w| w.speed_rad_s.abs() < limit)
         .collect();
-    let lesser = |split: usize| {
-        let (mut a, mut b) = (0.0, 0.0);
-        for w in &slow {
-            if w.rows.end <= split {
-                a += w.revolutions;
-            } else if w.rows.start >= split {
-                b += w.revolutions;
-            }
-        }
-        f64::min(a, b)
-    };
+    let slow: Vec<&SteadyWindow> = slow.iter().collect();
     let middle = at(0.5);
     let (lo, hi) = (at(0.5 - SPLIT_REACH), at(0.5 + SPLIT_REACH));
-    let (best, score) = slow
+    let (best, score) = balanced_boundary(&slow, middle, lo..=hi);
+    if score > 2.0 * lesser_side(&slow, middle) && score >= STEADY_MIN_REVOLUTIONS {
+        best
+    } else {
+        middle
+    }
+}
+
+/// Fastest steady rotation whose every angle-locked line (the slot order and 6·p_n) stays
+/// below a third of the log's rate. [rad/s]
+pub fn slow_line_speed(period_s: f64, rig: &Rig) -> f64 {
+    let highest = rig
+        .motor
+        .cogging_fundamental_order()
+        .max(6 * rig.motor.pole_pairs) as f64;
+    2.0 * PI / period_s / 3.0 / highest
+}
+
+/// Revolutions of `windows` on the lesser side of the boundary `split` (windows across it
+/// count on neither side). [1]
+pub fn lesser_side(windows: &[&SteadyWindow], split: usize) -> f64 {
+    let (mut a, mut b) = (0.0, 0.0);
+    for w in windows {
+        if w.rows.end <= split {
+            a += w.revolutions;
+        } else if w.rows.start >= split {
+            b += w.revolutions;
+        }
+    }
+    f64::min(a, b)
+}
+
+/// Of the windows' ends within `reach`, and `middle`, the boundary that leaves the lesser
+/// side the most revolutions (the one closer to `middle` on a tie), with those revolutions.
+pub fn balanced_boundary(
+    windows: &[&SteadyWindow],
+    middle: usize,
+    reach: RangeInclusive<usize>,
+) -> (usize, f64) {
+    windows
         .iter()
         .map(|w| w.rows.end)
-        .filter(|s| (lo..=hi).contains(s))
-        .map(|s| (s, lesser(s)))
-        .fold((middle, lesser(middle)), |b, c| {
+        .filter(|s| reach.contains(s))
+        .map(|s| (s, lesser_side(windows, s)))
+        .fold((middle, lesser_side(windows, middle)), |b, c| {
             let closer = c.0.abs_diff(middle) < b.0.abs_diff(middle);
             if c.1 > b.1 || (c.1 == b.1 && closer) {
                 c
             } else {
                 b
             }
-        });
-    if score > 2.0 * lesser(middle) && score >= STEADY_MIN_REVOLUTIONS {
-        best
-    } else {
-        middle
-    }
+        })
 }
 
 /// Rows spanning `seconds` at the sampling `period_s`, at least `min_rows`: the spans of
@@ -415,7 +430,7 @@ pub fn unwrap_angle(wrapped: &[f64]) -> Vec<f64> {
 /// window closes once it holds [`STEADY_TARGET_REVOLUTIONS`] and [`STEADY_TARGET_S`] (or
 /// [`STEADY_MAX_S`]); one cut short by a change of speed or the segment's end is kept if
 /// it holds at least [`STEADY_MIN_REVOLUTIONS`] and [`STEADY_WINDOW_S`].
-fn steady_windows(t: &[f64], theta: &[f64], period_s: f64) -> Vec<SteadyWindow> {
+pub fn steady_windows(t: &[f64], theta: &[f64], period_s: f64) -> Vec<SteadyWindow> {
     let n = t.len().min(theta.len());
     let chunk = ((STEADY_CHUNK_S / period_s).round() as usize).max(8);
     let speed =

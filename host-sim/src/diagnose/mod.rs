@@ -51,6 +51,7 @@ pub mod hydraulic;
 pub mod hydraulic_relation;
 pub mod intervals;
 pub mod least_squares;
+pub mod line_split;
 pub mod lines;
 pub mod loop_response;
 pub mod low_side;
