@@ -23,7 +23,8 @@
 //!    direction the identification leaves flat (a misfitting baseline bends its tolerances
 //!    to absorb the misfit) that end point, and the loss with it, is arbitrary. A loss
 //!    within [`SPREAD_QUANTILE`] standard errors of the tolerance does not refute an effect
-//!    whose Λ exceeds that reach ([`loss_inconclusive`]).
+//!    whose Λ exceeds that reach, nor does one under [`LOSS_SHARE_OF_EVIDENCE`] of Λ: the
+//!    validation segment does not excite that effect ([`loss_inconclusive`]).
 //! 4. **No structural veto.** A dead time and the flux harmonics share the lines at order
 //!    6·p_n: only the one that explains them better is named ([`apply_vetoes`]).
 //!
@@ -45,13 +46,23 @@ pub const SPREAD_QUANTILE: f64 = 1.96;
 /// Whether the validation loss `g` of `t` lies within what the two fits' own parameter
 /// uncertainty makes of it (within [`SPREAD_QUANTILE`] standard errors of the tolerance)
 /// while the identification's evidence, Λ, is larger than that uncertainty: the
-/// validation segment then cannot refute what the identification shows.
+/// validation segment then cannot refute what the identification shows. So too a loss under
+/// [`LOSS_SHARE_OF_EVIDENCE`] of Λ, whatever its spread.
 pub fn loss_inconclusive(t: &Tested, g: f64) -> bool {
-    t.validation_spread.is_some_and(|s| {
-        let reach = SPREAD_QUANTILE * s;
-        g + reach >= -VALIDATION_TOLERANCE && t.lambda >= reach
-    })
+    let slight = -g <= LOSS_SHARE_OF_EVIDENCE * t.lambda;
+    slight
+        || t.validation_spread.is_some_and(|s| {
+            let reach = SPREAD_QUANTILE * s;
+            g + reach >= -VALIDATION_TOLERANCE && t.lambda >= reach
+        })
 }
+
+/// Largest share of the identification's evidence Λ a validation loss may be and still be
+/// taken as the validation segment not exciting the effect: an effect the validation
+/// excited would gain there about what it gained on the identification, so a loss fifty
+/// times smaller than Λ comes from the other tolerances' extrapolation, not from the
+/// effect. [1]
+pub const LOSS_SHARE_OF_EVIDENCE: f64 = 0.02;
 
 /// The χ² threshold at [`FALSE_ALARM`] for `dof` degrees of freedom.
 pub fn threshold(dof: usize) -> f64 {
@@ -232,8 +243,12 @@ mod tests {
         t.validation_gain = Some(-98.0);
         t.validation_spread = Some(160.0);
         assert!(why_not(&t).is_none(), "{:?}", why_not(&t));
-        // A spread of 40: −98 + 78.4 = −19.6 lies below −3.84, a conclusive loss.
+        // A spread of 40: −98 + 78.4 = −19.6 lies below −3.84, a conclusive loss, but one
+        // under 2 % of Λ (98 against 3 000): the validation does not excite the effect.
         t.validation_spread = Some(40.0);
+        assert!(why_not(&t).is_none(), "{:?}", why_not(&t));
+        // Λ 3 000: the same loss is 3.3 % of it, and refutes.
+        t.lambda = 3_000.0;
         assert!(why_not(&t).is_some_and(|w| w.contains("refutes")));
         // No spread known: the loss refutes as it reads.
         t.validation_spread = None;
