@@ -307,7 +307,7 @@ mod tests {
         // A shaft turning at 30 rad/s with a small oscillation at order 24, d and q currents
         // with lines of their own, and the voltages of eq. 1–2 evaluated in time plus a
         // back-EMF line E_q = −ψ_f·ω̄_e·a, E_d = ψ_f·ω̄_e·b: the residual lines are a and b.
-        use crate::diagnose::facts::SteadyWindow;
+        use crate::diagnose::steady::SteadyWindow;
         use std::f64::consts::PI;
         let rig = Rig::nominal();
         let m = &rig.motor;

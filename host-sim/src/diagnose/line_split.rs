@@ -7,7 +7,7 @@
 //! where the lesser side keeps the most slow revolutions: at a slow window's end, or in the
 //! middle of a slow stretch that made one window only.
 
-use crate::diagnose::facts::{
+use crate::diagnose::steady::{
     lesser_side, slow_line_speed, steady_windows, SteadyWindow, STEADY_MIN_REVOLUTIONS,
 };
 use plant_model::Rig;

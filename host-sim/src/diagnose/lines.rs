@@ -17,7 +17,8 @@
 //! and leaves T_k near zero while the d current shows its line.
 
 use crate::bench_log::BenchLog;
-use crate::diagnose::facts::{LogFacts, SteadyWindow};
+use crate::diagnose::facts::LogFacts;
+use crate::diagnose::steady::SteadyWindow;
 use nalgebra::DMatrix;
 use plant_model::inverter::{dq_to_abc, pole_to_dq, Inverter};
 use plant_model::Rig;

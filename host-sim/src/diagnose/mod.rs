@@ -69,6 +69,7 @@ pub mod selection;
 pub mod signatures;
 pub mod spectrum;
 pub mod speed_angle;
+pub mod steady;
 pub mod stick;
 #[cfg(test)]
 mod test_noise;
