@@ -108,7 +108,7 @@ fn run(args: &[String]) -> Result<(), String> {
 }
 
 fn score(dir: &Path) -> Result<(), String> {
-    let tally = score_dir(dir, &[])?;
+    let tally = score_dir(dir, &[], None)?;
     let (right, n) = tally.total();
     println!("\n{}", tally.markdown());
     println!(

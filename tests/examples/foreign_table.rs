@@ -10,29 +10,48 @@
 //!
 //! `--drop COLUMN[,COLUMN…]` reads every log without those optional columns, as a bench
 //! that did not log them would have written it (`--drop theta_m_rad`: no angle).
+//! `--rows first:SHARE` or `--rows last:SHARE` reads only that share of each log's rows:
+//! a shorter log of the same test, or one whose recorder started late
+//! (`tests::blind::cut`).
 //!
 //! ```text
-//! cargo run --release -p tests --example foreign_table -- DIR [--drop COLUMNS]
+//! cargo run --release -p tests --example foreign_table -- DIR [--drop COLUMNS] [--rows first:0.45]
 //! ```
 
 use std::path::Path;
 use std::process::ExitCode;
+use tests::blind::cut::Cut;
 use tests::blind::judge::PARAMETER_TOLERANCE;
 use tests::blind::table::score_dir;
 
+const USAGE: &str = "usage: foreign_table DIR [--drop COLUMN[,COLUMN…]] \
+                     [--rows first:SHARE|last:SHARE] (bench logs and truth.json)";
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let (dir, drop) = match args.as_slice() {
-        [dir] => (dir, Vec::new()),
-        [dir, flag, columns] if flag == "--drop" => (dir, columns.split(',').collect()),
-        _ => {
-            eprintln!(
-                "usage: foreign_table DIR [--drop COLUMN[,COLUMN…]] (bench logs and truth.json)"
-            );
-            return ExitCode::from(2);
-        }
+    let Some((dir, options)) = args.split_first() else {
+        eprintln!("{USAGE}");
+        return ExitCode::from(2);
     };
-    match score_dir(Path::new(dir), &drop) {
+    let (mut drop, mut cut) = (Vec::new(), None);
+    let mut rest = options.iter();
+    while let Some(flag) = rest.next() {
+        match (flag.as_str(), rest.next()) {
+            ("--drop", Some(columns)) => drop.extend(columns.split(',')),
+            ("--rows", Some(rows)) => match Cut::parse(rows) {
+                Ok(c) => cut = Some(c),
+                Err(e) => {
+                    eprintln!("foreign_table: --rows {e}");
+                    return ExitCode::from(2);
+                }
+            },
+            _ => {
+                eprintln!("{USAGE}");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    match score_dir(Path::new(dir), &drop, cut) {
         Ok(tally) => {
             let (right, n) = tally.total();
             println!("\n{}", tally.markdown());

@@ -29,6 +29,7 @@
 
 mod bench_sensors;
 mod catalogue;
+pub mod cut;
 pub mod judge;
 mod observability;
 mod structure;

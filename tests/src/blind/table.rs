@@ -9,6 +9,7 @@
 //! alone, logs taken one after another. [`Tally`] counts the right ones by test, and apart
 //! for nothing hidden, one effect and pairs.
 
+use super::cut::Cut;
 use super::judge::{failures, main_parameter, read_said, truth_of_entry, Named, Said, Standard};
 use super::structure::drop_column;
 use host_sim::bench_log::{self, Signal};
@@ -122,12 +123,16 @@ fn score(
     name: &str,
     entry: &Value,
     drop: &[&str],
+    cut: Option<Cut>,
 ) -> Result<(String, bool, Vec<String>), String> {
     let hidden = truth_of_entry(entry).map_err(|e| format!("truth.json: {name}: {e}"))?;
     let path = dir.join(name);
     let mut log = bench_log::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     for column in drop {
         drop_column(&mut log, column);
+    }
+    if let Some(c) = cut {
+        log = c.apply(&log);
     }
     let start = Instant::now();
     let d = diagnose(&log, &Rig::nominal()).map_err(|e| format!("{name}: {e}"))?;
@@ -171,7 +176,7 @@ fn score(
 /// failures with each cause's evidence line; returns the tally (a log whose entry gives no
 /// `test` counts under `—`). Each log is read without the optional columns `drop` (a bench
 /// that did not log them); a name that is not an optional column is an error.
-pub fn score_dir(dir: &Path, drop: &[&str]) -> Result<Tally, String> {
+pub fn score_dir(dir: &Path, drop: &[&str], cut: Option<Cut>) -> Result<Tally, String> {
     let optional = |c: &str| Signal::from_name(c).is_some_and(|s| !s.is_required());
     if let Some(bad) = drop.iter().find(|c| !optional(c)) {
         return Err(format!(
@@ -200,7 +205,7 @@ pub fn score_dir(dir: &Path, drop: &[&str]) -> Result<Tally, String> {
     let (mut tally, mut details) = (Tally::default(), Vec::new());
     for name in &names {
         let entry = &cases[name.as_str()];
-        let (row, ok, detail) = score(dir, name, entry, drop)?;
+        let (row, ok, detail) = score(dir, name, entry, drop, cut)?;
         println!("{row}");
         let hidden = truth_of_entry(entry).map_or(0, |h| h.len());
         tally.add(
