@@ -202,15 +202,27 @@ impl BenchLog {
         if keep.len() == self.len() {
             return None;
         }
+        Some(self.each_column(|column| keep.iter().map(|&k| column[k]).collect()))
+    }
+
+    /// The rows `rows` (clamped to the log), their times as logged, the metadata kept.
+    pub fn rows(&self, rows: std::ops::Range<usize>) -> BenchLog {
+        let end = rows.end.min(self.len());
+        let rows = rows.start.min(end)..end;
+        self.each_column(|column| column[rows.clone()].to_vec())
+    }
+
+    /// A log with this one's metadata and each column `pick` makes of this one's; a column
+    /// let go (empty, see [`BenchLog::check_holding`]) stays empty.
+    fn each_column(&self, pick: impl Fn(&[f64]) -> Vec<f64>) -> BenchLog {
         let mut out = BenchLog {
             metadata: self.metadata.clone(),
             ..BenchLog::default()
         };
-        // A column let go (empty, see [`BenchLog::check_holding`]) stays empty.
         for (signal, column) in self.columns().filter(|(_, c)| !c.is_empty()) {
-            *out.column_mut(signal) = keep.iter().map(|&k| column[k]).collect();
+            *out.column_mut(signal) = pick(column);
         }
-        Some(out)
+        out
     }
 
     /// The value of the first metadata line with `key`.

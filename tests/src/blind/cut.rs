@@ -31,7 +31,7 @@ impl Cut {
     }
 
     /// The rows of `log` this cut keeps (`share·rows` rounded down, at least two), with their
-    /// logged times and the log's metadata; a column let go stays empty.
+    /// logged times and the log's metadata ([`BenchLog::rows`]).
     pub fn apply(self, log: &BenchLog) -> BenchLog {
         let n = log.len();
         let (share, first) = match self {
@@ -39,15 +39,7 @@ impl Cut {
             Cut::Last(s) => (s, false),
         };
         let keep = ((share * n as f64) as usize).clamp(2.min(n), n);
-        let rows = if first { 0..keep } else { n - keep..n };
-        let mut out = BenchLog {
-            metadata: log.metadata.clone(),
-            ..BenchLog::default()
-        };
-        for (signal, column) in log.columns().filter(|(_, c)| !c.is_empty()) {
-            *out.column_mut(signal) = column[rows.clone()].to_vec();
-        }
-        out
+        log.rows(if first { 0..keep } else { n - keep..n })
     }
 }
 
@@ -77,6 +69,9 @@ mod tests {
         assert!(last.x_m.is_none());
         // However small the share, two rows.
         assert_eq!(Cut::First(0.01).apply(&log).len(), 2);
+        // Rows past the log's end are not there to keep.
+        assert_eq!(log.rows(8..20).t_s, [8.0, 9.0]);
+        assert!(log.rows(12..20).is_empty());
     }
 
     #[test]
