@@ -3,7 +3,7 @@
 //! (`crate::compensate`), a pressure step and a speed step — a summary table, the runs' bench logs and
 //! SVG plots in an output folder.
 
-use super::holding::pulsation;
+use super::holding::{pulsation, Pulsation};
 use super::{converged, effects_text, plant_rig, rig_name};
 use crate::bench_log::write_into;
 use crate::feedforward::Feedforward;
@@ -18,7 +18,7 @@ use plant_model::effects::paper_low_speed_effects;
 use plant_model::{Effect, Rig};
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `eha demo`.
 #[derive(Debug, Args)]
@@ -69,67 +69,83 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     let out = &args.out;
     let effects: Vec<Effect> = paper_low_speed_effects().to_vec();
     let plant = plant_rig(rig, &effects)?;
+    let hold =
+        by_name("pressure-hold").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
+    // The torque feed-forward and the speed modulation learned as a bench would: the
+    // drive's sweep and a 12 s hold at 5 MPa, `eha compensate`'s model method.
+    let (ff_table, ff_logs) = crate::compensate::study::bench_learning(rig, &plant, 12.0)?;
+    let [with, without, with_ff, without_ff, stepped, sped] =
+        demo_runs(rig, &plant, &effects, &ff_table)?;
+    let pw = pulsation(&with, hold, &plant);
+    let po = pulsation(&without, hold, &plant);
+    let pwf = pulsation(&with_ff, hold, &plant);
+    let pof = pulsation(&without_ff, hold, &plant);
+    let table = summary(rig, out, &with, [&pw, &po, &pwf, &pof]);
+    let mut outputs = Outputs::new();
+    outputs.folder("--out", out, FILES, |d| {
+        d.file("compensation.table", &ff_table.file_bytes())?;
+        write_into(d, "compensation-sweep.csv", &ff_logs[0])?;
+        write_into(d, "pressure-hold.csv", &with.log)?;
+        write_into(d, "pressure-hold-no-absorber.csv", &without.log)?;
+        write_into(d, "pressure-step.csv", &stepped.log)?;
+        write_into(d, "speed-step.csv", &sped.log)?;
+        let runs = Runs {
+            with: &with,
+            without: &without,
+            without_ff: &without_ff,
+            stepped: &stepped,
+            sped: &sped,
+        };
+        figures(d, &runs, (&pw, &po), &plant, hold.steady_from_s)
+    })?;
+    outputs.print(&table);
+    outputs.commit()
+}
+
+/// The demo's six closed-loop runs, in parallel: holding with and without the absorber,
+/// each without and with the feed-forward `ff_table`, then a pressure step and a speed
+/// step, all on `plant` (the rig with `effects`).
+fn demo_runs(
+    rig: &Rig,
+    plant: &Rig,
+    effects: &[Effect],
+    ff_table: &Feedforward,
+) -> Result<[Run; 6], CliError> {
     // The reference is the rig without absorber, its controller configured for that rig
     // (the pressure loop's schedule then sees only the oil's capacitance).
     let mut bare = plant.clone();
     bare.absorber.enabled = false;
     let mut bare_controller = rig.clone();
     bare_controller.absorber.enabled = false;
-    let hold =
-        by_name("pressure-hold").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
-    let step =
-        by_name("pressure-step").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
-    let speed_step =
-        by_name("speed-step").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
+    let scenario =
+        |name: &str| by_name(name).ok_or_else(|| CliError::Failed("scenario missing".into()));
+    let (hold, step, speed_step) = (
+        scenario("pressure-hold")?,
+        scenario("pressure-step")?,
+        scenario("speed-step")?,
+    );
     let meta = |scenario: &str, absorber: &str| {
         vec![
             ("source".to_string(), "simulation".to_string()),
             ("rig".into(), rig_name(rig).into()),
             ("scenario".into(), scenario.into()),
-            ("effects".into(), effects_text(rig, &effects)),
+            ("effects".into(), effects_text(rig, effects)),
             ("absorber".into(), absorber.into()),
         ]
     };
-    // The torque feed-forward and the speed modulation learned as a bench would: the
-    // drive's sweep and a 12 s hold at 5 MPa, `eha compensate`'s model method.
-    let (ff_table, ff_logs) = crate::compensate::study::bench_learning(rig, &plant, 12.0)?;
-    // In parallel: holding with and without the absorber, each without and with the
-    // feed-forward, a pressure step and a speed step.
+    let held = |p, c, absorber, table| (p, c, hold, 4.0, meta("pressure-hold", absorber), table);
     let jobs: Vec<Job> = vec![
-        (
-            &plant,
-            rig,
-            hold,
-            4.0,
-            meta("pressure-hold", "fitted"),
-            None,
-        ),
-        (
+        held(plant, rig, "fitted", None),
+        held(&bare, &bare_controller, "none", None),
+        held(plant, rig, "fitted, feed-forward", Some(ff_table)),
+        held(
             &bare,
             &bare_controller,
-            hold,
-            4.0,
-            meta("pressure-hold", "none"),
-            None,
+            "none, feed-forward",
+            Some(ff_table),
         ),
         (
-            &plant,
-            rig,
-            hold,
-            4.0,
-            meta("pressure-hold", "fitted, feed-forward"),
-            Some(&ff_table),
-        ),
-        (
-            &bare,
-            &bare_controller,
-            hold,
-            4.0,
-            meta("pressure-hold", "none, feed-forward"),
-            Some(&ff_table),
-        ),
-        (
-            &plant,
+            plant,
             rig,
             step,
             step.duration_s,
@@ -137,7 +153,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             None,
         ),
         (
-            &plant,
+            plant,
             rig,
             speed_step,
             0.4,
@@ -164,20 +180,19 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
             )
         })
         .collect();
-    let mut runs = runs.into_iter();
-    let mut next = || {
-        runs.next()
-            .unwrap_or_else(|| Err("run missing".into()))
-            .map_err(CliError::Failed)
-            .and_then(|r| converged(r, None))
-    };
-    let (with, without) = (next()?, next()?);
-    let (with_ff, without_ff) = (next()?, next()?);
-    let (stepped, sped) = (next()?, next()?);
-    let pw = pulsation(&with, hold, &plant);
-    let po = pulsation(&without, hold, &plant);
-    let pwf = pulsation(&with_ff, hold, &plant);
-    let pof = pulsation(&without_ff, hold, &plant);
+    let runs: Vec<Run> = runs
+        .into_iter()
+        .map(|r| r.map_err(CliError::Failed).and_then(|r| converged(r, None)))
+        .collect::<Result<_, _>>()?;
+    runs.try_into()
+        .map_err(|_| CliError::Failed("run missing".into()))
+}
+
+/// The demo's summary table: the holding's pulsation with the absorber, without it, and
+/// each with the feed-forward (`[with, without, with_ff, without_ff]`), the absorption and
+/// the feed-forward's reduction, and what was written to `out`.
+fn summary(rig: &Rig, out: &Path, with: &Run, p: [&Pulsation; 4]) -> String {
+    let [pw, po, pwf, pof] = p;
     let mut table = String::new();
     let _ = writeln!(
         table,
@@ -196,10 +211,10 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
     );
     let fitted = format!("fitted, p0 {:.1} MPa", rig.absorber.precharge_pa / 1e6);
     for (label, p) in [
-        (fitted.clone(), &pw),
-        ("none".to_string(), &po),
-        ("none + feed-forward".to_string(), &pof),
-        (format!("{fitted} + ff"), &pwf),
+        (fitted.clone(), pw),
+        ("none".to_string(), po),
+        ("none + feed-forward".to_string(), pof),
+        (format!("{fitted} + ff"), pwf),
     ] {
         let cause = match p.cause {
             Some(s) => format!("{} ({:.0})", s.cause, s.order),
@@ -244,25 +259,7 @@ pub fn run_demo(rig: &Rig, args: &DemoArgs) -> Result<(), CliError> {
         "\nwritten to {}/: pressure-hold.csv (bench log), pressure-hold-no-absorber.csv, pressure-step.csv, speed-step.csv, compensation-sweep.csv (the feed-forward's bench sweep), compensation.table, pressure_trace, pulsation_spectrum, pressure_step, speed_step (each .svg and .png)",
         out.display()
     );
-    let mut outputs = Outputs::new();
-    outputs.folder("--out", out, FILES, |d| {
-        d.file("compensation.table", &ff_table.file_bytes())?;
-        write_into(d, "compensation-sweep.csv", &ff_logs[0])?;
-        write_into(d, "pressure-hold.csv", &with.log)?;
-        write_into(d, "pressure-hold-no-absorber.csv", &without.log)?;
-        write_into(d, "pressure-step.csv", &stepped.log)?;
-        write_into(d, "speed-step.csv", &sped.log)?;
-        let runs = Runs {
-            with: &with,
-            without: &without,
-            without_ff: &without_ff,
-            stepped: &stepped,
-            sped: &sped,
-        };
-        figures(d, &runs, (&pw, &po), &plant, hold.steady_from_s)
-    })?;
-    outputs.print(&table);
-    outputs.commit()
+    table
 }
 
 /// The demo's runs the figures show.
@@ -280,7 +277,7 @@ struct Runs<'a> {
 fn figures(
     d: &StagedFolder,
     r: &Runs,
-    (pw, po): (&super::holding::Pulsation, &super::holding::Pulsation),
+    (pw, po): (&Pulsation, &Pulsation),
     plant: &Rig,
     steady_from_s: f64,
 ) -> Result<(), CliError> {

@@ -6,13 +6,14 @@ pub mod demo;
 pub mod holding;
 
 use crate::bench_log::{self, MIN_ROWS};
+use crate::feedforward::Feedforward;
 use crate::output::paths::Declared;
 use crate::output::{CliError, Outputs};
 use crate::rig_file;
 use crate::run::{first_unphysical, log_plan, most_rows, run, Run, RunOptions, LOGGED_COLUMNS};
 use crate::values::{positive_f64, show};
 use clap::Args;
-use closed_loop::{by_name, PROCEDURES, SCENARIOS};
+use closed_loop::{by_name, Scenario, PROCEDURES, SCENARIOS};
 use plant_model::effects::{EffectError, EFFECT_NAMES};
 use plant_model::{Effect, Integrator, Rig};
 use serde_json::json;
@@ -277,46 +278,14 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     // run's time taken out): the real-time factor a user of the command sees.
     let started = std::time::Instant::now();
     if args.list {
-        let mut s = String::new();
-        for sc in SCENARIOS.iter().chain(&PROCEDURES) {
-            let _ = writeln!(
-                s,
-                "{:<19} {:>4.1} s  {}",
-                sc.name, sc.duration_s, sc.description
-            );
-        }
-        let mut out = Outputs::new();
-        out.print(&s);
-        return out.commit();
+        return print_list();
     }
-    let name = args.scenario.as_deref().unwrap_or_default();
-    let scenario = by_name(name).ok_or_else(|| {
-        let names: Vec<&str> = SCENARIOS
-            .iter()
-            .chain(&PROCEDURES)
-            .map(|s| s.name)
-            .collect();
-        CliError::BadInput(format!(
-            "unknown scenario `{name}`: the scenarios are {} (see `eha simulate --list`)",
-            names.join(", ")
-        ))
-    })?;
+    let scenario = scenario_named(args.scenario.as_deref().unwrap_or_default())?;
     let out = args
         .out
         .as_ref()
         .ok_or_else(|| CliError::BadInput("--out LOG.csv is required".into()))?;
-    let mut controller = rig.clone();
-    if let Some(p0) = args.precharge {
-        controller.absorber.precharge_pa = p0;
-    }
-    controller.validate().map_err(|e| {
-        CliError::BadInput(match args.precharge {
-            Some(p0) if e.parameter == "absorber.precharge_pa" => {
-                format!("--precharge {}: {e}", show(p0))
-            }
-            _ => e.to_string(),
-        })
-    })?;
+    let controller = controller_rig(rig, args.precharge)?;
     let effects = args
         .effects
         .as_ref()
@@ -348,32 +317,7 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
         ("seed".into(), format!("{seed}")),
         ("integrator".into(), args.integrator.name().into()),
     ];
-    if let Some(path) = &args.plant_rig {
-        metadata.push(("plant_rig".into(), path.display().to_string()));
-    }
-    if let Some(drive) = &args.drive {
-        metadata.push((bench_log::DRIVE_KEY.into(), drive.clone()));
-    }
-    if let Some(at) = &args.recorded_at {
-        metadata.push((bench_log::RECORDED_AT_KEY.into(), at.clone()));
-    }
-    if let (Some(path), Some(t)) = (&args.compensation, &compensation) {
-        metadata.push((
-            "compensation".into(),
-            format!(
-                "{} (CRC {:#010x}; speed modulation {})",
-                path.display(),
-                firmware::compensation::record::crc_of(&t.table),
-                match &t.flow {
-                    Some(f) => format!(
-                        "{} pistons, {:.4} peak-to-peak, phase {} rad",
-                        f.pistons, f.ratio, f.phase_rad
-                    ),
-                    None => "off".into(),
-                }
-            ),
-        ));
-    }
+    metadata.extend(optional_metadata(args, compensation.as_ref()));
     let options = RunOptions {
         duration_s: duration,
         log_rate_hz: args.log_rate,
@@ -411,18 +355,141 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
     bench_log::stage(&mut outputs, "--out", out, &r.log)?;
     let command_s = started.elapsed().saturating_sub(comparison).as_secs_f64();
     if let Some(json_path) = &args.json {
+        let ran = Ran {
+            scenario,
+            duration_s: duration,
+            out,
+            integrator: args.integrator,
+            run: &r,
+            command_s,
+            compared: compared.as_ref(),
+        };
+        outputs.json("--json", json_path, &ran.summary())?;
+    }
+    outputs.commit()?;
+    report(
+        scenario,
+        duration,
+        out,
+        args.integrator,
+        &r,
+        compared.as_ref(),
+    );
+    Ok(())
+}
+
+/// `eha simulate --list`: the scenarios and procedures, a line each.
+fn print_list() -> Result<(), CliError> {
+    let mut s = String::new();
+    for sc in SCENARIOS.iter().chain(&PROCEDURES) {
+        let _ = writeln!(
+            s,
+            "{:<19} {:>4.1} s  {}",
+            sc.name, sc.duration_s, sc.description
+        );
+    }
+    let mut out = Outputs::new();
+    out.print(&s);
+    out.commit()
+}
+
+/// The scenario or procedure called `name`, or an error listing them.
+fn scenario_named(name: &str) -> Result<&'static Scenario, CliError> {
+    by_name(name).ok_or_else(|| {
+        let names: Vec<&str> = SCENARIOS
+            .iter()
+            .chain(&PROCEDURES)
+            .map(|s| s.name)
+            .collect();
+        CliError::BadInput(format!(
+            "unknown scenario `{name}`: the scenarios are {} (see `eha simulate --list`)",
+            names.join(", ")
+        ))
+    })
+}
+
+/// The rig the controller is configured from: `rig` with `--precharge` in place, validated
+/// (an invalid precharge named as the option).
+fn controller_rig(rig: &Rig, precharge: Option<f64>) -> Result<Rig, CliError> {
+    let mut controller = rig.clone();
+    if let Some(p0) = precharge {
+        controller.absorber.precharge_pa = p0;
+    }
+    controller.validate().map_err(|e| {
+        CliError::BadInput(match precharge {
+            Some(p0) if e.parameter == "absorber.precharge_pa" => {
+                format!("--precharge {}: {e}", show(p0))
+            }
+            _ => e.to_string(),
+        })
+    })?;
+    Ok(controller)
+}
+
+/// The log's metadata lines that only some runs have: the plant's own rig file, the drive,
+/// the start of the recording and the torque feed-forward loaded.
+fn optional_metadata(
+    args: &SimulateArgs,
+    compensation: Option<&Feedforward>,
+) -> Vec<(String, String)> {
+    let mut metadata = Vec::new();
+    if let Some(path) = &args.plant_rig {
+        metadata.push(("plant_rig".into(), path.display().to_string()));
+    }
+    if let Some(drive) = &args.drive {
+        metadata.push((bench_log::DRIVE_KEY.into(), drive.clone()));
+    }
+    if let Some(at) = &args.recorded_at {
+        metadata.push((bench_log::RECORDED_AT_KEY.into(), at.clone()));
+    }
+    if let (Some(path), Some(t)) = (&args.compensation, compensation) {
+        metadata.push((
+            "compensation".into(),
+            format!(
+                "{} (CRC {:#010x}; speed modulation {})",
+                path.display(),
+                firmware::compensation::record::crc_of(&t.table),
+                match &t.flow {
+                    Some(f) => format!(
+                        "{} pistons, {:.4} peak-to-peak, phase {} rad",
+                        f.pistons, f.ratio, f.phase_rad
+                    ),
+                    None => "off".into(),
+                }
+            ),
+        ));
+    }
+    metadata
+}
+
+/// A finished `eha simulate` run, as `--json` reports it.
+struct Ran<'a> {
+    scenario: &'static Scenario,
+    duration_s: f64,
+    out: &'a Path,
+    integrator: Integrator,
+    run: &'a Run,
+    /// The command's wall clock, the comparison run taken out. [s]
+    command_s: f64,
+    compared: Option<&'a (Integrator, Run)>,
+}
+
+impl Ran<'_> {
+    /// The `--json` summary: rows, the real-time factors, and the comparison run's.
+    fn summary(&self) -> serde_json::Value {
+        let r = self.run;
         let mut summary = json!({
-            "scenario": scenario.name,
-            "duration_s": duration,
+            "scenario": self.scenario.name,
+            "duration_s": self.duration_s,
             "rows": r.log.len(),
-            "out": out.display().to_string(),
+            "out": self.out.display().to_string(),
             "real_time_factor": r.real_time_factor,
             "cpu_real_time_factor": r.cpu_real_time_factor,
-            "command_wall_s": command_s,
-            "command_real_time_factor": duration / command_s.max(1e-9),
-            "integrator": args.integrator.name(),
+            "command_wall_s": self.command_s,
+            "command_real_time_factor": self.duration_s / self.command_s.max(1e-9),
+            "integrator": self.integrator.name(),
         });
-        if let Some((other, o)) = &compared {
+        if let Some((other, o)) = self.compared {
             summary["compared"] = json!({
                 "integrator": other.name(),
                 "real_time_factor": o.real_time_factor,
@@ -430,29 +497,38 @@ pub fn run_simulate(rig: &Rig, args: &SimulateArgs) -> Result<(), CliError> {
                 "speedup": r.cpu_real_time_factor / o.cpu_real_time_factor,
             });
         }
-        outputs.json("--json", json_path, &summary)?;
+        summary
     }
-    outputs.commit()?;
+}
+
+/// The run's line on standard error, and the comparison's.
+fn report(
+    scenario: &Scenario,
+    duration_s: f64,
+    out: &Path,
+    integrator: Integrator,
+    r: &Run,
+    compared: Option<&(Integrator, Run)>,
+) {
     eprintln!(
-        "{}: {} rows over {duration} s written to {} ({:.0}× real time, {:.0}× per CPU second, \
+        "{}: {} rows over {duration_s} s written to {} ({:.0}× real time, {:.0}× per CPU second, \
          {})",
         scenario.name,
         r.log.len(),
         out.display(),
         r.real_time_factor,
         r.cpu_real_time_factor,
-        args.integrator.name()
+        integrator.name()
     );
-    if let Some((other, o)) = &compared {
+    if let Some((other, o)) = compared {
         eprintln!(
             "{}: {:.0}× per CPU second; {} is {:.2}× as fast",
             other.name(),
             o.cpu_real_time_factor,
-            args.integrator.name(),
+            integrator.name(),
             r.cpu_real_time_factor / o.cpu_real_time_factor
         );
     }
-    Ok(())
 }
 
 #[cfg(test)]
