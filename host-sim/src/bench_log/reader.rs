@@ -45,12 +45,8 @@ fn parse_thinned<R: Read>(
     path: &Path,
     min_interval_s: f64,
 ) -> Result<(BenchLog, usize), BenchLogError> {
-    let err = |line: usize, column: &str, problem: Problem| BenchLogError::Content {
-        file: path.to_path_buf(),
-        line,
-        column: excerpt(column),
-        problem,
-    };
+    let err =
+        |line: usize, column: &str, problem: Problem| content_error(path, line, column, problem);
     let io_err = |source| BenchLogError::Read {
         file: path.to_path_buf(),
         source,
@@ -93,29 +89,7 @@ fn parse_thinned<R: Read>(
     }
     let header_line = line_of(&record, consumed + 1);
     let names: Vec<String> = record.iter().map(str::to_string).collect();
-    for (i, n) in names.iter().enumerate() {
-        if let Some(j) = names[..i].iter().position(|m| m == n) {
-            return Err(err(
-                header_line,
-                n,
-                Problem::DuplicateColumn {
-                    first: j + 1,
-                    second: i + 1,
-                },
-            ));
-        }
-    }
-    for s in Signal::ALL.into_iter().filter(|s| s.is_required()) {
-        if !names.iter().any(|n| n == s.name()) {
-            return Err(err(header_line, s.name(), Problem::MissingColumn));
-        }
-    }
-    // (field index, signal) of the columns the contract knows; others are not read.
-    let known: Vec<(usize, Signal)> = names
-        .iter()
-        .enumerate()
-        .filter_map(|(i, n)| Signal::from_name(n).map(|s| (i, s)))
-        .collect();
+    let known = known_columns(&names, path, header_line)?;
     for &(_, s) in &known {
         log.column_mut(s);
     }
@@ -137,47 +111,12 @@ fn parse_thinned<R: Read>(
             let problem = Problem::TooManyRows { most: most_rows };
             return Err(err(line, Signal::Time.name(), problem));
         }
-        if record.len() != names.len() {
-            let column = names
-                .get(record.len().min(names.len().saturating_sub(1)))
-                .filter(|_| record.len() < names.len())
-                .cloned()
-                .unwrap_or_else(|| format!("field {}", names.len() + 1));
-            return Err(err(
-                line,
-                &column,
-                Problem::WrongFieldCount {
-                    expected: names.len(),
-                    found: record.len(),
-                },
-            ));
-        }
-        for (slot, &(i, s)) in values.iter_mut().zip(&known) {
-            let text = record.get(i).unwrap_or("");
-            let v = match text.parse::<f64>() {
-                Ok(v) if v.is_finite() => v,
-                _ if text.is_empty() => return Err(err(line, s.name(), Problem::EmptyField)),
-                _ => {
-                    return Err(err(
-                        line,
-                        s.name(),
-                        Problem::NotANumber {
-                            text: excerpt(text),
-                        },
-                    ))
-                }
-            };
-            if out_of_range(s, v) {
-                return Err(err(line, s.name(), beyond(s, v)));
-            }
-            if s == Signal::Time {
-                if let Some(problem) = previous_t.and_then(|p| time_problem(p, v)) {
-                    return Err(err(line, s.name(), problem));
-                }
-                previous_t = Some(v);
-            }
-            *slot = v;
-        }
+        let row = Row {
+            record: &record,
+            line,
+            path,
+        };
+        row.read_into(&names, &known, &mut values, &mut previous_t)?;
         rows += 1;
         let t = previous_t.unwrap_or(0.0);
         if keeps_row(log.t_s.last().copied(), t, min_interval_s) {
@@ -199,6 +138,105 @@ fn parse_thinned<R: Read>(
         log.column_mut(s).shrink_to_fit();
     }
     Ok((log, rows))
+}
+
+/// The error of `path`'s content at `line` and `column`.
+fn content_error(path: &Path, line: usize, column: &str, problem: Problem) -> BenchLogError {
+    BenchLogError::Content {
+        file: path.to_path_buf(),
+        line,
+        column: excerpt(column),
+        problem,
+    }
+}
+
+/// The header `names` (at `header_line` of `path`) checked: no name twice, every required
+/// column present. Returns (field index, signal) of the columns the contract knows; others
+/// are not read.
+fn known_columns(
+    names: &[String],
+    path: &Path,
+    header_line: usize,
+) -> Result<Vec<(usize, Signal)>, BenchLogError> {
+    let err = |column: &str, problem| content_error(path, header_line, column, problem);
+    for (i, n) in names.iter().enumerate() {
+        if let Some(j) = names[..i].iter().position(|m| m == n) {
+            let problem = Problem::DuplicateColumn {
+                first: j + 1,
+                second: i + 1,
+            };
+            return Err(err(n, problem));
+        }
+    }
+    for s in Signal::ALL.into_iter().filter(|s| s.is_required()) {
+        if !names.iter().any(|n| n == s.name()) {
+            return Err(err(s.name(), Problem::MissingColumn));
+        }
+    }
+    Ok(names
+        .iter()
+        .enumerate()
+        .filter_map(|(i, n)| Signal::from_name(n).map(|s| (i, s)))
+        .collect())
+}
+
+/// One data row of the CSV, at `line` of `path`.
+struct Row<'a> {
+    record: &'a csv::StringRecord,
+    line: usize,
+    path: &'a Path,
+}
+
+impl Row<'_> {
+    /// Reads the `known` columns of the row into `values`, each checked: the row has as
+    /// many fields as the header `names`, every value is a finite number within its
+    /// signal's range, and the time increases from `previous_t` (updated).
+    fn read_into(
+        &self,
+        names: &[String],
+        known: &[(usize, Signal)],
+        values: &mut [f64],
+        previous_t: &mut Option<f64>,
+    ) -> Result<(), BenchLogError> {
+        let err = |column: &str, problem| content_error(self.path, self.line, column, problem);
+        let record = self.record;
+        if record.len() != names.len() {
+            let column = names
+                .get(record.len().min(names.len().saturating_sub(1)))
+                .filter(|_| record.len() < names.len())
+                .cloned()
+                .unwrap_or_else(|| format!("field {}", names.len() + 1));
+            let problem = Problem::WrongFieldCount {
+                expected: names.len(),
+                found: record.len(),
+            };
+            return Err(err(&column, problem));
+        }
+        for (slot, &(i, s)) in values.iter_mut().zip(known) {
+            let text = record.get(i).unwrap_or("");
+            let v = match text.parse::<f64>() {
+                Ok(v) if v.is_finite() => v,
+                _ if text.is_empty() => return Err(err(s.name(), Problem::EmptyField)),
+                _ => {
+                    let problem = Problem::NotANumber {
+                        text: excerpt(text),
+                    };
+                    return Err(err(s.name(), problem));
+                }
+            };
+            if out_of_range(s, v) {
+                return Err(err(s.name(), beyond(s, v)));
+            }
+            if s == Signal::Time {
+                if let Some(problem) = previous_t.and_then(|p| time_problem(p, v)) {
+                    return Err(err(s.name(), problem));
+                }
+                *previous_t = Some(v);
+            }
+            *slot = v;
+        }
+        Ok(())
+    }
 }
 
 /// Reads the `# key: value` lines (and blank lines) before the header of `input` into
