@@ -138,45 +138,8 @@ pub fn tune(
             "the rig gives a controller configuration the firmware refuses: {e}"
         ))
     })?;
-    let (signal, reference, response) = match kind {
-        LoopKind::Speed => {
-            let r = log.speed_ref_rad_s.as_deref().ok_or_else(|| {
-                TuneError::BadLog(
-                    "the log has no speed_ref_rad_s column: a speed step cannot be found".into(),
-                )
-            })?;
-            (Signal::Speed, r, &log.speed_rad_s[..])
-        }
-        LoopKind::Pressure => (Signal::Pressure, &log.p_ref_pa[..], &log.p_pa[..]),
-    };
-    let step = step::find(&log.t_s, reference, signal).map_err(|e| no_step(kind, e))?;
     let limit = config.speed.speed_limit_rad_s as f64;
-    if signal == Signal::Speed && step.from.abs().max(step.to.abs()) >= 0.99 * limit {
-        // The pressure loop's output pinned at the limit holds too, but is no setpoint.
-        return Err(TuneError::BadLog(format!(
-            "no speed setpoint step in the log: its speed_ref_rad_s steps between {:.0} and \
-             {:.0} rad/s, at the {limit:.0} rad/s limit (a saturated pressure loop, not a \
-             speed setpoint)",
-            step.from, step.to
-        )));
-    }
-    // A lone sample leaving both neighbours by half the step is no response of the loop.
-    if let Some(k) = glitch::lone_spike(response, 0.5 * (step.to - step.from).abs()) {
-        let (column, unit, scale) = match kind {
-            LoopKind::Speed => ("speed_rad_s", "rad/s", 1.0),
-            LoopKind::Pressure => ("p_pa", "MPa", 1e-6),
-        };
-        return Err(TuneError::BadLog(format!(
-            "the log's {column} at t = {:.4} s (data row {}) reads {:.4} {unit} between {:.4} and \
-             {:.4} {unit}: a dropped or corrupted sample, which would bias the identification; \
-             repair or remove that row",
-            log.t_s[k],
-            k + 1,
-            response[k] * scale,
-            response[k - 1] * scale,
-            response[k + 1] * scale
-        )));
-    }
+    let (signal, response, step) = setpoint_step(kind, log, limit)?;
     check_followed(kind, log, response, &step)?;
     let measured = step::metrics(&log.t_s, response, &step, signal);
     let mut notes = Vec::new();
@@ -211,39 +174,9 @@ pub fn tune(
         }
     };
     let (spec, identified, proposal, replayed_current) = t;
-    if let Identified::Pressure { high, .. } = &identified {
-        if high.precharge_is_lower_bound {
-            notes.push(format!(
-                "the absorber took no oil in this log: its precharge is above {:.2} MPa, the \
-                 highest pressure reached; the proposal assumes it there (a step to higher \
-                 pressure would locate it)",
-                high.precharge_pa / 1e6
-            ));
-        }
-    }
-    if !proposal.metrics.meets(&target) {
-        notes.push(
-            "no candidate design meets the target on the identified plant: the proposal \
-             misses it least (the documented design where others gain under a tenth)"
-                .into(),
-        );
-    }
+    notes.extend(proposal_notes(&identified, &proposal, &target));
     let cfg = &proposal.design.config;
-    let ids: &[ParamId] = match kind {
-        LoopKind::Speed => &[ParamId::SpeedKp, ParamId::SpeedKi],
-        LoopKind::Pressure => &[
-            ParamId::AbsorberPrechargePa,
-            ParamId::PressureBandwidth,
-            ParamId::PressureIntegralCornerRatio,
-        ],
-    };
-    let settings = ids
-        .iter()
-        .map(|&id| Setting {
-            id,
-            value: id.get(cfg) as f64,
-        })
-        .collect();
+    let settings = settings(kind, cfg);
     let current_gains = match kind {
         LoopKind::Speed => Gains {
             kp: config.speed.kp as f64,
@@ -268,6 +201,101 @@ pub fn tune(
         replayed_current,
         notes,
     })
+}
+
+/// The loop's signal, its response column and the setpoint step found in `log`; refuses a
+/// speed "step" at the speed `limit` [rad/s] (a saturated pressure loop) and a response
+/// with a lone corrupted sample.
+fn setpoint_step(
+    kind: LoopKind,
+    log: &BenchLog,
+    limit: f64,
+) -> Result<(Signal, &[f64], step::Step), TuneError> {
+    let (signal, reference, response) = match kind {
+        LoopKind::Speed => {
+            let r = log.speed_ref_rad_s.as_deref().ok_or_else(|| {
+                TuneError::BadLog(
+                    "the log has no speed_ref_rad_s column: a speed step cannot be found".into(),
+                )
+            })?;
+            (Signal::Speed, r, &log.speed_rad_s[..])
+        }
+        LoopKind::Pressure => (Signal::Pressure, &log.p_ref_pa[..], &log.p_pa[..]),
+    };
+    let step = step::find(&log.t_s, reference, signal).map_err(|e| no_step(kind, e))?;
+    if signal == Signal::Speed && step.from.abs().max(step.to.abs()) >= 0.99 * limit {
+        // The pressure loop's output pinned at the limit holds too, but is no setpoint.
+        return Err(TuneError::BadLog(format!(
+            "no speed setpoint step in the log: its speed_ref_rad_s steps between {:.0} and \
+             {:.0} rad/s, at the {limit:.0} rad/s limit (a saturated pressure loop, not a \
+             speed setpoint)",
+            step.from, step.to
+        )));
+    }
+    // A lone sample leaving both neighbours by half the step is no response of the loop.
+    if let Some(k) = glitch::lone_spike(response, 0.5 * (step.to - step.from).abs()) {
+        let (column, unit, scale) = match kind {
+            LoopKind::Speed => ("speed_rad_s", "rad/s", 1.0),
+            LoopKind::Pressure => ("p_pa", "MPa", 1e-6),
+        };
+        return Err(TuneError::BadLog(format!(
+            "the log's {column} at t = {:.4} s (data row {}) reads {:.4} {unit} between {:.4} and \
+             {:.4} {unit}: a dropped or corrupted sample, which would bias the identification; \
+             repair or remove that row",
+            log.t_s[k],
+            k + 1,
+            response[k] * scale,
+            response[k - 1] * scale,
+            response[k + 1] * scale
+        )));
+    }
+    Ok((signal, response, step))
+}
+
+/// The notes the identified plant and the chosen proposal call for: an absorber that took
+/// no oil, a target no candidate meets.
+fn proposal_notes(
+    identified: &Identified,
+    proposal: &candidates::Candidate,
+    target: &Target,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    if let Identified::Pressure { high, .. } = identified {
+        if high.precharge_is_lower_bound {
+            notes.push(format!(
+                "the absorber took no oil in this log: its precharge is above {:.2} MPa, the \
+                 highest pressure reached; the proposal assumes it there (a step to higher \
+                 pressure would locate it)",
+                high.precharge_pa / 1e6
+            ));
+        }
+    }
+    if !proposal.metrics.meets(target) {
+        notes.push(
+            "no candidate design meets the target on the identified plant: the proposal \
+             misses it least (the documented design where others gain under a tenth)"
+                .into(),
+        );
+    }
+    notes
+}
+
+/// The live parameters that carry the proposal `cfg` for a loop of `kind`.
+fn settings(kind: LoopKind, cfg: &Config) -> Vec<Setting> {
+    let ids: &[ParamId] = match kind {
+        LoopKind::Speed => &[ParamId::SpeedKp, ParamId::SpeedKi],
+        LoopKind::Pressure => &[
+            ParamId::AbsorberPrechargePa,
+            ParamId::PressureBandwidth,
+            ParamId::PressureIntegralCornerRatio,
+        ],
+    };
+    ids.iter()
+        .map(|&id| Setting {
+            id,
+            value: id.get(cfg) as f64,
+        })
+        .collect()
 }
 
 /// Refuses a step the loop's response did not follow at least [`step::MIN_FOLLOWED`] of

@@ -91,53 +91,7 @@ impl Tuning {
             self.step.to * scale,
             self.step_time_s
         );
-        match &self.identified {
-            Identified::Speed {
-                shaft,
-                assumed_inertia_kg_m2,
-                ..
-            } => {
-                let _ = writeln!(
-                    s,
-                    "identified: inertia {:.3e} kg·m² ({:.2}× the rig's {:.3e}), viscous {:.2e} \
-                     N·m·s, load {:.3} N·m; fit {:.1} %",
-                    shaft.inertia_kg_m2,
-                    shaft.inertia_kg_m2 / assumed_inertia_kg_m2,
-                    assumed_inertia_kg_m2,
-                    shaft.viscous_nm_s,
-                    shaft.load_nm,
-                    shaft.fit_percent
-                );
-            }
-            Identified::Pressure {
-                high,
-                assumed_precharge_pa,
-                capacitance_m3_per_pa,
-                assumed_capacitance_m3_per_pa,
-                ..
-            } => {
-                let _ = writeln!(
-                    s,
-                    "identified: capacitance at {:.2} MPa {:.3e} m³/Pa (the schedule assumes \
-                     {:.3e}, {:.1}×); oil {:.3e} m³/Pa, leakage {:.2e} (m³/s)/Pa, absorber \
-                     precharge {}{:.2} MPa (assumed {:.2} MPa); fit {:.1} %",
-                    self.step.to * 1e-6,
-                    capacitance_m3_per_pa,
-                    assumed_capacitance_m3_per_pa,
-                    assumed_capacitance_m3_per_pa / capacitance_m3_per_pa,
-                    high.oil_capacitance_m3_per_pa,
-                    high.leakage_m3_per_s_pa,
-                    if high.precharge_is_lower_bound {
-                        "> "
-                    } else {
-                        ""
-                    },
-                    high.precharge_pa * 1e-6,
-                    assumed_precharge_pa * 1e-6,
-                    high.fit_percent
-                );
-            }
-        }
+        s.push_str(&self.identified_text());
         let settle = |m: &StepMetrics| {
             m.settling_s
                 .map_or("not settled".to_string(), |v| format!("{v:.3} s"))
@@ -185,6 +139,59 @@ impl Tuning {
         let _ = writeln!(s, "CAN commands (cansend, node {}):", can::NODE);
         for c in commands {
             let _ = writeln!(s, "  {c}");
+        }
+        s
+    }
+
+    /// The identified plant's line of the report.
+    fn identified_text(&self) -> String {
+        let mut s = String::new();
+        match &self.identified {
+            Identified::Speed {
+                shaft,
+                assumed_inertia_kg_m2,
+                ..
+            } => {
+                let _ = writeln!(
+                    s,
+                    "identified: inertia {:.3e} kg·m² ({:.2}× the rig's {:.3e}), viscous {:.2e} \
+                     N·m·s, load {:.3} N·m; fit {:.1} %",
+                    shaft.inertia_kg_m2,
+                    shaft.inertia_kg_m2 / assumed_inertia_kg_m2,
+                    assumed_inertia_kg_m2,
+                    shaft.viscous_nm_s,
+                    shaft.load_nm,
+                    shaft.fit_percent
+                );
+            }
+            Identified::Pressure {
+                high,
+                assumed_precharge_pa,
+                capacitance_m3_per_pa,
+                assumed_capacitance_m3_per_pa,
+                ..
+            } => {
+                let _ = writeln!(
+                    s,
+                    "identified: capacitance at {:.2} MPa {:.3e} m³/Pa (the schedule assumes \
+                     {:.3e}, {:.1}×); oil {:.3e} m³/Pa, leakage {:.2e} (m³/s)/Pa, absorber \
+                     precharge {}{:.2} MPa (assumed {:.2} MPa); fit {:.1} %",
+                    self.step.to * 1e-6,
+                    capacitance_m3_per_pa,
+                    assumed_capacitance_m3_per_pa,
+                    assumed_capacitance_m3_per_pa / capacitance_m3_per_pa,
+                    high.oil_capacitance_m3_per_pa,
+                    high.leakage_m3_per_s_pa,
+                    if high.precharge_is_lower_bound {
+                        "> "
+                    } else {
+                        ""
+                    },
+                    high.precharge_pa * 1e-6,
+                    assumed_precharge_pa * 1e-6,
+                    high.fit_percent
+                );
+            }
         }
         s
     }
