@@ -17,6 +17,7 @@ use firmware::config::Config;
 use firmware::parameters::ParamId;
 use firmware::Command;
 use indicatif::{ProgressBar, ProgressStyle};
+use plant_model::accumulator::Absorber;
 use plant_model::{Integrator, Rig};
 use std::time::{Duration, Instant};
 
@@ -161,18 +162,7 @@ pub fn run_with_config(
     let mut cols: [Vec<f64>; 8] = Default::default();
     let mut p_true = Vec::with_capacity(n_rows);
     let mut w_true = Vec::with_capacity(n_rows);
-    let bar = if opt.progress && opt.duration_s > 20.0 {
-        let b = ProgressBar::new(n_rows as u64);
-        b.set_style(
-            ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b.set_message(scenario.name);
-        b.enable_steady_tick(Duration::from_millis(200));
-        Some(b)
-    } else {
-        None
-    };
+    let bar = (opt.progress && opt.duration_s > 20.0).then(|| progress_bar(n_rows, scenario.name));
     let started = Instant::now();
     let cpu_started = thread_cpu_s();
     let mut k = 0u64;
@@ -222,23 +212,8 @@ pub fn run_with_config(
     log.ud_v = Some(ud);
     log.uq_v = Some(uq);
     log.udc_v = Some(udc);
-    let steady: Vec<f64> = log
-        .t_s
-        .iter()
-        .zip(&p_true)
-        .filter(|(t, _)| **t >= scenario.steady_from_s.min(opt.duration_s / 2.0))
-        .map(|(_, p)| *p)
-        .collect();
-    let mean = steady.iter().sum::<f64>() / steady.len().max(1) as f64;
-    let absorber = cl.plant().absorber();
-    let (fn_hz, zeta) = if absorber.enabled {
-        (
-            absorber.natural_frequency_rad_s(mean) / (2.0 * std::f64::consts::PI),
-            absorber.damping_ratio(mean),
-        )
-    } else {
-        (0.0, 0.0)
-    };
+    let steady_from_s = scenario.steady_from_s.min(opt.duration_s / 2.0);
+    let (fn_hz, zeta) = absorber_at_mean(cl.plant().absorber(), &log.t_s, &p_true, steady_from_s);
     Ok(Run {
         log,
         p_true_pa: p_true,
@@ -248,6 +223,43 @@ pub fn run_with_config(
         real_time_factor: opt.duration_s / wall.max(1e-9),
         cpu_real_time_factor: opt.duration_s / cpu.max(1e-9),
     })
+}
+
+/// The run's progress bar over `rows` logged rows, labelled `name`.
+fn progress_bar(rows: usize, name: &'static str) -> ProgressBar {
+    let b = ProgressBar::new(rows as u64);
+    b.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message(name);
+    b.enable_steady_tick(Duration::from_millis(200));
+    b
+}
+
+/// The absorber's natural frequency [Hz] and damping ratio [1] at the mean of the true
+/// port pressure `p_true` [Pa] from `steady_from_s` on (times `t_s`); zeros without one.
+fn absorber_at_mean(
+    absorber: &Absorber,
+    t_s: &[f64],
+    p_true: &[f64],
+    steady_from_s: f64,
+) -> (f64, f64) {
+    let steady: Vec<f64> = t_s
+        .iter()
+        .zip(p_true)
+        .filter(|(t, _)| **t >= steady_from_s)
+        .map(|(_, p)| *p)
+        .collect();
+    let mean = steady.iter().sum::<f64>() / steady.len().max(1) as f64;
+    if absorber.enabled {
+        (
+            absorber.natural_frequency_rad_s(mean) / (2.0 * std::f64::consts::PI),
+            absorber.damping_ratio(mean),
+        )
+    } else {
+        (0.0, 0.0)
+    }
 }
 
 /// The calling thread's CPU time (user and system), if the platform has a thread clock. [s]

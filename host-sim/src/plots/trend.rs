@@ -20,6 +20,9 @@ pub struct TrendPanel {
     pub crossing: Option<((f64, f64, f64), String)>,
 }
 
+/// An axis's range: (low, high).
+type Span = (f64, f64);
+
 const POINTS: RGBColor = RGBColor(31, 119, 180);
 const LINE: RGBColor = RGBColor(44, 160, 44);
 const LIMIT: RGBColor = RGBColor(214, 39, 40);
@@ -41,6 +44,38 @@ fn bounds(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
         lo.abs().max(1.0) * 1e-3
     };
     Some((lo - pad, hi + pad))
+}
+
+/// The panel's x and y ranges: the estimates, the fitted line with its band, the crossing
+/// and the limit, padded; refused when there is nothing to draw or the span is too wide.
+fn panel_range(p: &TrendPanel) -> Result<(Span, Span), String> {
+    let xs = p
+        .points
+        .iter()
+        .map(|q| q.0)
+        .chain(p.line.iter().map(|q| q.0))
+        .chain(p.crossing.iter().flat_map(|((_, lo, hi), _)| [*lo, *hi]));
+    // The estimates, the band and the limit set the y range; an error bar longer than
+    // that is cut at the frame (a log whose parameter it could not tell apart can have a
+    // standard error of 1e100 and would otherwise flatten every other point).
+    let ys = p
+        .points
+        .iter()
+        .map(|q| q.1)
+        .chain(p.line.iter().flat_map(|q| [q.2, q.3]))
+        .chain(p.limit);
+    let ((x0, x1), (y0, y1)) = match (bounds(xs), bounds(ys)) {
+        (Some(x), Some(y)) => (x, y),
+        _ => return Err("nothing to draw".into()),
+    };
+    if !(x1 - x0 <= MAX_SPAN && y1 - y0 <= MAX_SPAN) {
+        return Err(format!(
+            "the data span {:e} by {:e}, too wide to draw",
+            x1 - x0,
+            y1 - y0
+        ));
+    }
+    Ok(((x0, x1), (y0, y1)))
 }
 
 /// Renders `panels` stacked under `title`; `name` (the figure's file name) names it in
@@ -69,32 +104,7 @@ fn draw<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     p: &TrendPanel,
 ) -> Result<(), String> {
-    let xs = p
-        .points
-        .iter()
-        .map(|q| q.0)
-        .chain(p.line.iter().map(|q| q.0))
-        .chain(p.crossing.iter().flat_map(|((_, lo, hi), _)| [*lo, *hi]));
-    // The estimates, the band and the limit set the y range; an error bar longer than
-    // that is cut at the frame (a log whose parameter it could not tell apart can have a
-    // standard error of 1e100 and would otherwise flatten every other point).
-    let ys = p
-        .points
-        .iter()
-        .map(|q| q.1)
-        .chain(p.line.iter().flat_map(|q| [q.2, q.3]))
-        .chain(p.limit);
-    let ((x0, x1), (y0, y1)) = match (bounds(xs), bounds(ys)) {
-        (Some(x), Some(y)) => (x, y),
-        _ => return Err("nothing to draw".into()),
-    };
-    if !(x1 - x0 <= MAX_SPAN && y1 - y0 <= MAX_SPAN) {
-        return Err(format!(
-            "the data span {:e} by {:e}, too wide to draw",
-            x1 - x0,
-            y1 - y0
-        ));
-    }
+    let ((x0, x1), (y0, y1)) = panel_range(p)?;
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let mut chart = ChartBuilder::on(area)
         .margin(10)

@@ -77,6 +77,7 @@
 //! rather than tuning the rig to them.
 
 use plant_model::accumulator::{Absorber, ATMOSPHERE_PA};
+use plant_model::rig::AbsorberParams;
 use plant_model::Rig;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -195,8 +196,9 @@ pub struct WorkingPointDesign {
     pub highest_damping_ratio: f64,
 }
 
-/// Applies the selection method to `rig` at working pressure `working_pa` (gauge).
-pub fn design(rig: &Rig, working_pa: f64) -> Result<AccumulatorDesign, DesignError> {
+/// Refuses a working pressure (gauge) [Pa] at or below the fill pressure or at or above
+/// the relief valve's cracking pressure.
+fn check_working_pressure(rig: &Rig, working_pa: f64) -> Result<(), DesignError> {
     let fill_pa = rig.fill.pressure_pa;
     if !working_pa.is_finite() || working_pa <= fill_pa {
         return Err(DesignError::PressureBelowFill {
@@ -210,6 +212,35 @@ pub fn design(rig: &Rig, working_pa: f64) -> Result<AccumulatorDesign, DesignErr
             relief_pa: rig.fill.relief_cracking_pa,
         });
     }
+    Ok(())
+}
+
+/// Eq. 31–32's conditions at the working pressure `working_pa` (gauge) [Pa] instead of
+/// the precharge state, for the pulsation `omega_1` [rad/s]: p_0 = p_w·(n·p_w·C/V_0)^n.
+fn working_point(a: &AbsorberParams, working_pa: f64, omega_1: f64) -> WorkingPointDesign {
+    let (i, r, v0, n) = (
+        a.inlet_inertance_kg_m4,
+        a.inlet_resistance_pa_s_m3,
+        a.shell_volume_m3,
+        a.polytropic_exponent,
+    );
+    let pw_abs = working_pa + ATMOSPHERE_PA;
+    let precharge_for = |c: f64| {
+        let p0_abs = pw_abs * (n * pw_abs * c / v0).powf(n);
+        (p0_abs < pw_abs).then_some(p0_abs - ATMOSPHERE_PA)
+    };
+    let c_max = v0 / (n * pw_abs);
+    WorkingPointDesign {
+        p11_pa: precharge_for(1.0 / (i * omega_1 * omega_1)),
+        p12_pa: precharge_for(2.0 * i / (r * r)),
+        lowest_natural_frequency_hz: 1.0 / (i * c_max).sqrt() / (2.0 * PI),
+        highest_damping_ratio: 0.5 * r * (c_max / i).sqrt(),
+    }
+}
+
+/// Applies the selection method to `rig` at working pressure `working_pa` (gauge).
+pub fn design(rig: &Rig, working_pa: f64) -> Result<AccumulatorDesign, DesignError> {
+    check_working_pressure(rig, working_pa)?;
     let a = &rig.absorber;
     let (i, r, v0, n) = (
         a.inlet_inertance_kg_m4,
@@ -235,19 +266,7 @@ pub fn design(rig: &Rig, working_pa: f64) -> Result<AccumulatorDesign, DesignErr
     let zeta = absorber.damping_ratio(working_pa);
     let capacitance = absorber.gas.capacitance_m3_per_pa(working_pa);
 
-    // The same conditions at the working pressure: p_0 = p_w·(n·p_w·C/V_0)^n.
-    let pw_abs = working_pa + ATMOSPHERE_PA;
-    let precharge_for = |c: f64| {
-        let p0_abs = pw_abs * (n * pw_abs * c / v0).powf(n);
-        (p0_abs < pw_abs).then_some(p0_abs - ATMOSPHERE_PA)
-    };
-    let c_max = v0 / (n * pw_abs);
-    let working = WorkingPointDesign {
-        p11_pa: precharge_for(1.0 / (i * omega_1 * omega_1)),
-        p12_pa: precharge_for(2.0 * i / (r * r)),
-        lowest_natural_frequency_hz: 1.0 / (i * c_max).sqrt() / (2.0 * PI),
-        highest_damping_ratio: 0.5 * r * (c_max / i).sqrt(),
-    };
+    let working = working_point(a, working_pa, omega_1);
 
     let paper_p11_abs = PAPER_RANGE_PA[0] + ATMOSPHERE_PA;
     let paper_p12_abs = PAPER_RANGE_PA[1] + ATMOSPHERE_PA;

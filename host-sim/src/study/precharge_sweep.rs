@@ -12,7 +12,7 @@ use crate::simulate::holding::{holding_run, pulsation, Pulsation};
 use crate::simulate::{effects_text, plant_rig};
 use crate::values::{positive_f64, show};
 use clap::Args;
-use closed_loop::by_name;
+use closed_loop::{by_name, Scenario};
 use plant_model::effects::paper_low_speed_effects;
 use plant_model::{Effect, Rig};
 use rayon::prelude::*;
@@ -90,77 +90,17 @@ fn log_name(p0: f64, decimals: usize) -> String {
 /// A sweep result: precharge (None for the reference without absorber), run, figures.
 type SweepPoint = (Option<f64>, Run, Pulsation);
 
+/// The sweep's runs: the reference's without the absorber with its pulsation, and each
+/// precharge [Pa] with its run and pulsation.
+type Swept = ((Run, Pulsation), Vec<(f64, Run, Pulsation)>);
+
 /// `eha sweep-precharge`.
 pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), CliError> {
-    if args.values.is_empty() {
-        return Err(CliError::BadInput(
-            "--values needs at least one precharge".into(),
-        ));
-    }
-    if args.values.len() > MAX_POINTS {
-        return Err(CliError::BadInput(format!(
-            "--values names {} precharges; a sweep runs at most {MAX_POINTS} (each is a 4 s \
-             closed-loop run)",
-            args.values.len()
-        )));
-    }
-    for (i, v) in args.values.iter().enumerate() {
-        if args.values[..i].contains(v) {
-            return Err(CliError::BadInput(format!(
-                "--values names the precharge {} Pa twice",
-                show(*v)
-            )));
-        }
-    }
-    let effects: Vec<Effect> = paper_low_speed_effects().to_vec();
+    check_values(&args.values)?;
     let hold =
         by_name("pressure-hold").ok_or_else(|| CliError::Failed("scenario missing".into()))?;
     let duration = 4.0;
-    // Reference: the same run without the absorber; then one run per precharge, all in parallel.
-    let mut jobs: Vec<(Option<f64>, Rig, Rig)> = Vec::new();
-    let mut bare = plant_rig(rig, &effects)?;
-    bare.absorber.enabled = false;
-    let mut bare_controller = rig.clone();
-    bare_controller.absorber.enabled = false;
-    jobs.push((None, bare, bare_controller));
-    for &p0 in &args.values {
-        let mut controller = rig.clone();
-        controller.absorber.precharge_pa = p0;
-        controller
-            .validate()
-            .map_err(|e| CliError::BadInput(format!("--values: precharge {} Pa: {e}", show(p0))))?;
-        let plant = plant_rig(&controller, &effects)?;
-        jobs.push((Some(p0), plant, controller));
-    }
-    let results: Vec<Result<SweepPoint, CliError>> = jobs
-        .par_iter()
-        .map(|(p0, plant, controller)| {
-            let meta = vec![
-                ("source".to_string(), "simulation".to_string()),
-                ("scenario".into(), "pressure-hold".into()),
-                ("effects".into(), effects_text(rig, &effects)),
-                (
-                    "precharge_pa".into(),
-                    p0.map(|p| format!("{p}"))
-                        .unwrap_or_else(|| "no absorber".into()),
-                ),
-            ];
-            let r = holding_run(plant, controller, duration, meta)?;
-            let p = pulsation(&r, hold, plant);
-            Ok((*p0, r, p))
-        })
-        .collect();
-    let mut reference = None;
-    let mut points = Vec::new();
-    for r in results {
-        let (p0, run, p) = r?;
-        match p0 {
-            None => reference = Some((run, p)),
-            Some(v) => points.push((v, run, p)),
-        }
-    }
-    let (ref_run, ref_p) =
-        reference.ok_or_else(|| CliError::Failed("reference run missing".into()))?;
+    let ((ref_run, ref_p), points) = sweep_runs(rig, &args.values, hold, duration)?;
     let mut table = format!(
         "Precharge sweep, low-speed holding at 5 MPa (Section 5.2); without absorber: {:.0} Pa peak-to-peak\n\n{:>10} {:>14} {:>11} {:>16} {:>9} {:>28}\n",
         ref_p.pp_pa, "precharge", "pulsation pp", "absorption", "natural freq.", "damping", "dominant line"
@@ -222,6 +162,88 @@ pub fn run_sweep_precharge(rig: &Rig, args: &SweepPrechargeArgs) -> Result<(), C
         out.print(&table);
     }
     out.commit()
+}
+
+/// Refuses an empty list of precharges, one longer than [`MAX_POINTS`], and a precharge
+/// named twice.
+fn check_values(values: &[f64]) -> Result<(), CliError> {
+    if values.is_empty() {
+        return Err(CliError::BadInput(
+            "--values needs at least one precharge".into(),
+        ));
+    }
+    if values.len() > MAX_POINTS {
+        return Err(CliError::BadInput(format!(
+            "--values names {} precharges; a sweep runs at most {MAX_POINTS} (each is a 4 s \
+             closed-loop run)",
+            values.len()
+        )));
+    }
+    for (i, v) in values.iter().enumerate() {
+        if values[..i].contains(v) {
+            return Err(CliError::BadInput(format!(
+                "--values names the precharge {} Pa twice",
+                show(*v)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The sweep's holding runs of `duration` [s], in parallel: the reference without the
+/// absorber, and one per precharge of `values` [Pa] (each validated on the rig). Returns
+/// the reference's run and pulsation, and each precharge's.
+fn sweep_runs(
+    rig: &Rig,
+    values: &[f64],
+    hold: &Scenario,
+    duration: f64,
+) -> Result<Swept, CliError> {
+    let effects: Vec<Effect> = paper_low_speed_effects().to_vec();
+    let mut jobs: Vec<(Option<f64>, Rig, Rig)> = Vec::new();
+    let mut bare = plant_rig(rig, &effects)?;
+    bare.absorber.enabled = false;
+    let mut bare_controller = rig.clone();
+    bare_controller.absorber.enabled = false;
+    jobs.push((None, bare, bare_controller));
+    for &p0 in values {
+        let mut controller = rig.clone();
+        controller.absorber.precharge_pa = p0;
+        controller
+            .validate()
+            .map_err(|e| CliError::BadInput(format!("--values: precharge {} Pa: {e}", show(p0))))?;
+        let plant = plant_rig(&controller, &effects)?;
+        jobs.push((Some(p0), plant, controller));
+    }
+    let results: Vec<Result<SweepPoint, CliError>> = jobs
+        .par_iter()
+        .map(|(p0, plant, controller)| {
+            let meta = vec![
+                ("source".to_string(), "simulation".to_string()),
+                ("scenario".into(), "pressure-hold".into()),
+                ("effects".into(), effects_text(rig, &effects)),
+                (
+                    "precharge_pa".into(),
+                    p0.map(|p| format!("{p}"))
+                        .unwrap_or_else(|| "no absorber".into()),
+                ),
+            ];
+            let r = holding_run(plant, controller, duration, meta)?;
+            let p = pulsation(&r, hold, plant);
+            Ok((*p0, r, p))
+        })
+        .collect();
+    let mut reference = None;
+    let mut points = Vec::new();
+    for r in results {
+        let (p0, run, p) = r?;
+        match p0 {
+            None => reference = Some((run, p)),
+            Some(v) => points.push((v, run, p)),
+        }
+    }
+    let reference = reference.ok_or_else(|| CliError::Failed("reference run missing".into()))?;
+    Ok((reference, points))
 }
 
 /// Writes the runs' bench logs and the two figures into the sweep's folder.
