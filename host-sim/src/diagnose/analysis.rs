@@ -15,7 +15,7 @@
 
 use super::angle_locked::{EmfLines, LineReading, ShaftConstants};
 use super::calibration::{calibrate, polished, test_release_at_nominal, Release};
-use super::candidates::{from_release, test_lines, test_relation, Extension, Tested};
+use super::candidates::{test_lines, Extension, Tested};
 use super::contributions::contributions;
 use super::cylinder::{self};
 use super::diagnosis::Diagnosis;
@@ -29,6 +29,7 @@ use super::mechanical_relation::mech;
 use super::predictions::{predict, Context, ModelValues};
 pub use super::relations::Precision;
 use super::relations::{Calibrations, Relations};
+use super::release_verdict::{from_release, test_relation};
 use super::result::{assemble, calibration_values, extended_values, fit_each, fit_of, Scored};
 use super::selection::select;
 use crate::bench_log::{BenchLog, Signal};
@@ -242,12 +243,7 @@ pub fn analyse_reporting(
     // 2. Calibration.
     let mut cal = calibrate_all(&rel, progress);
     // 3. Lines, read with the calibrated shaft.
-    let mv = &cal.mechanical.fitted.values;
-    let shaft = ShaftConstants {
-        kt: 1.5 * rig.motor.pole_pairs as f64 * mv[mech::PSI],
-        j: mv[mech::INERTIA],
-        d_per_rad: mv[mech::DISPLACEMENT] / (2.0 * std::f64::consts::PI),
-    };
+    let shaft = shaft_constants(&cal, rig);
     let orders = &rel.orders;
     let lines = window_lines(log, &facts, rig, orders, shaft.kt, shaft.j, shaft.d_per_rad);
     let (line_id, line_val): (Vec<_>, Vec<_>) = lines
@@ -300,23 +296,8 @@ pub fn analyse_reporting(
         electrical: rel.electrical.as_ref(),
         cylinder: rel.cylinder.as_ref(),
     };
-    let base_values = ModelValues {
-        hydraulic: cal.hydraulic.fitted.values.clone(),
-        mechanical: cal.mechanical.fitted.values.clone(),
-        lines: Vec::new(),
-        electrical: cal.electrical.as_ref().map(|c| c.fitted.values.clone()),
-        cylinder: cal.cylinder.as_ref().map(|c| c.fitted.values.clone()),
-        pressure_from_cylinder: named
-            .iter()
-            .any(|&i| matches!(tested[i].extension, Extension::Cylinder(_))),
-    };
-    let mut ext_values = base_values.clone();
-    for &i in &named {
-        ext_values = extended_values(&ext_values, &tested[i].extension, rig, shaft);
-    }
-    if let Some(v) = hydraulic_values {
-        ext_values.hydraulic = v;
-    }
+    let (base_values, ext_values) =
+        model_values(&cal, (&tested, &named), hydraulic_values, rig, shaft);
     // Beside the baseline's whole-log predictions (the evidence reads them), every other
     // model's signals are predicted and scored one at a time.
     let baseline = predict(&ctx, &base_values);
@@ -351,4 +332,45 @@ pub fn analyse_reporting(
     a.contributions = contributions;
     progress.step("done");
     Ok(a)
+}
+
+/// The shaft's constants as the calibration fitted them: torque constant, inertia and the
+/// pump's displacement per radian.
+fn shaft_constants(cal: &Calibrations, rig: &Rig) -> ShaftConstants {
+    let mv = &cal.mechanical.fitted.values;
+    ShaftConstants {
+        kt: 1.5 * rig.motor.pole_pairs as f64 * mv[mech::PSI],
+        j: mv[mech::INERTIA],
+        d_per_rad: mv[mech::DISPLACEMENT] / (2.0 * std::f64::consts::PI),
+    }
+}
+
+/// The baseline's values (the calibration's) and the extended model's: the baseline with
+/// every `named` effect's extension, and the hydraulic values the selection refitted
+/// together (`hydraulic_values`) in place of the calibration's.
+fn model_values(
+    cal: &Calibrations,
+    (tested, named): (&[Tested], &[usize]),
+    hydraulic_values: Option<Vec<f64>>,
+    rig: &Rig,
+    shaft: ShaftConstants,
+) -> (ModelValues, ModelValues) {
+    let base_values = ModelValues {
+        hydraulic: cal.hydraulic.fitted.values.clone(),
+        mechanical: cal.mechanical.fitted.values.clone(),
+        lines: Vec::new(),
+        electrical: cal.electrical.as_ref().map(|c| c.fitted.values.clone()),
+        cylinder: cal.cylinder.as_ref().map(|c| c.fitted.values.clone()),
+        pressure_from_cylinder: named
+            .iter()
+            .any(|&i| matches!(tested[i].extension, Extension::Cylinder(_))),
+    };
+    let mut ext_values = base_values.clone();
+    for &i in named {
+        ext_values = extended_values(&ext_values, &tested[i].extension, rig, shaft);
+    }
+    if let Some(v) = hydraulic_values {
+        ext_values.hydraulic = v;
+    }
+    (base_values, ext_values)
 }

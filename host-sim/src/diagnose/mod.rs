@@ -62,6 +62,7 @@ pub mod predictions;
 pub mod relations;
 #[cfg(test)]
 mod release_tests;
+mod release_verdict;
 pub mod report;
 pub mod result;
 pub mod secant;

@@ -25,10 +25,11 @@ use super::ambiguity::mark;
 use super::calibration::{
     calibrate, polished, test_release, Calibration, Freed, Relation, Release,
 };
-use super::candidates::{from_release, reread, Extension, Tested};
+use super::candidates::{reread, Extension, Tested};
 use super::decision::{apply_vetoes, threshold, why_not};
 use super::displacement::{read_volumes_at, Displacement};
 use super::relations::Relations;
+use super::release_verdict::from_release;
 use plant_model::Rig;
 use rayon::prelude::*;
 
