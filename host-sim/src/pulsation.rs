@@ -12,7 +12,7 @@ use rustfft::{num_complex::Complex, FftPlannerScalar};
 pub struct Source {
     /// What causes it.
     pub cause: &'static str,
-    /// Cycles per mechanical revolution.
+    /// Cycles per mechanical revolution. [1/rev]
     pub order: f64,
 }
 

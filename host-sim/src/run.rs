@@ -32,13 +32,13 @@ pub struct Run {
     /// The absorber's natural frequency and damping ratio at the run's mean pressure
     /// (0 when the absorber holds no oil). [Hz], [1]
     pub absorber_fn_hz: f64,
-    /// See `absorber_fn_hz`.
+    /// The absorber's damping ratio at the run's mean pressure (0 when it holds no oil). [1]
     pub absorber_zeta: f64,
-    /// Simulated seconds per wall-clock second.
+    /// Simulated seconds per wall-clock second. [1]
     pub real_time_factor: f64,
     /// Simulated seconds per second of the running thread's own CPU time (what the run
     /// costs, whatever else the machine is doing; the wall-clock factor where the platform
-    /// has no thread clock).
+    /// has no thread clock). [1]
     pub cpu_real_time_factor: f64,
 }
 

@@ -14,7 +14,7 @@ pub struct TrendPanel {
     pub points: Vec<(f64, f64, f64)>,
     /// The fitted line, its low and high 2σ edges: (x, centre, low, high).
     pub line: Vec<(f64, f64, f64, f64)>,
-    /// The limit, if any.
+    /// The limit, if any. [the panel's unit]
     pub limit: Option<f64>,
     /// Crossing: (x, 2σ before, 2σ after) and its legend text.
     pub crossing: Option<((f64, f64, f64), String)>,

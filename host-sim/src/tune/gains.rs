@@ -5,8 +5,8 @@
 /// [(rad/s)/Pa], [(rad/s)/(Pa·s)].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gains {
-    /// Proportional gain.
+    /// Proportional gain. [A/(rad/s)] or [(rad/s)/Pa]
     pub kp: f64,
-    /// Integral gain.
+    /// Integral gain. [A/rad] or [(rad/s)/(Pa·s)]
     pub ki: f64,
 }

@@ -69,7 +69,8 @@ impl StepSpec {
 pub struct Response {
     /// Sample instants. [s]
     pub t_s: Vec<f64>,
-    /// The controller's reference (ramped pressure setpoint, or speed reference).
+    /// The controller's reference (ramped pressure setpoint [Pa], or speed reference
+    /// [rad/s]).
     pub reference: Vec<f64>,
     /// The controller's measurement (pressure [Pa] or speed [rad/s]).
     pub measured: Vec<f64>,

@@ -107,9 +107,11 @@ pub(super) struct WindingPoints {
     pub u: [[f64; 2]; 2],
     /// Electrical angle turned since the start, at τ/2 and τ. [rad]
     pub turned: [f64; 2],
-    /// Electrical speed at τ/2 and τ, and acceleration at τ. [rad/s], [rad/s²]
+    /// Electrical speed at τ/2. [rad/s]
     pub omega_e_mid: f64,
+    /// Electrical speed at τ. [rad/s]
     pub omega_e: f64,
+    /// Electrical acceleration at τ. [rad/s²]
     pub alpha_e: f64,
 }
 
