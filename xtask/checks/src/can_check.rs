@@ -220,74 +220,87 @@ fn expected_reply(r: &Reply) -> Expected {
     }
 }
 
-/// Every frame kind, with every code of every value table.
+/// Every frame kind, with every code of every value table: the commands, then the replies.
 fn samples() -> Vec<Sample> {
-    let mut v = Vec::new();
-    for f in Function::ALL {
-        // Exhaustive: a new command breaks the build here until it has samples.
-        let requests: Vec<Request> = match f {
-            Function::SetMode => Mode::ALL.iter().map(|m| Request::SetMode(*m)).collect(),
-            Function::SetPressure => [0, 5_000_000, -101_325, i32::MAX, i32::MIN]
-                .iter()
-                .map(|pa| Request::SetPressure { pa: *pa })
-                .collect(),
-            Function::SetSpeed => [0, 1_234, -52_360, i32::MAX, i32::MIN]
-                .iter()
-                .map(|m| Request::SetSpeed { mrad_s: *m })
-                .collect(),
-            Function::ClearFaults => vec![Request::ClearFaults],
-            Function::Heartbeat => vec![Request::Heartbeat],
-            Function::SetParameter => ParamId::ALL
-                .iter()
-                .map(|id| Request::SetParameter {
-                    id: *id,
-                    // A value inside the bounds that is not a round number.
-                    value: id.min() + (id.max() - id.min()) * 0.3141,
-                })
-                .collect(),
-            Function::GetParameter => ParamId::ALL
-                .iter()
-                .map(|id| Request::GetParameter { id: *id })
-                .collect(),
-            Function::SaveParameters => vec![Request::SaveParameters],
-            Function::StepTest => StepLoop::ALL
-                .iter()
-                .zip([(-2.5f32, 1u16), (12.75, 250), (1.5e6, 65_535)])
-                .map(|(l, (a, ms))| Request::StepTest {
-                    target: *l,
-                    amplitude: a,
-                    duration_ms: ms,
-                })
-                .collect(),
-            Function::Commission => vec![Request::Commission],
-            Function::CompensationBin => vec![
-                Request::CompensationHeader {
-                    exponents: [19, 40, -3],
-                    bins: 512,
-                },
-                Request::CompensationBin {
-                    bin: 0,
-                    raw: [0, 0, 0],
-                },
-                Request::CompensationBin {
-                    bin: 511,
-                    raw: [i16::MIN, -1234, i16::MAX],
-                },
-            ],
-            Function::CompensationCommit => [0u32, 0x8123_FB45, u32::MAX]
-                .iter()
-                .map(|crc| Request::CompensationCommit { crc: *crc })
-                .collect(),
-            Function::CompensationSweep => [(10.0f32, 6000u16), (-2.5, 1), (1e3, 65_535)]
-                .iter()
-                .map(|(w, ms)| Request::CompensationSweep {
-                    speed_rad_s: *w,
-                    leg_ms: *ms,
-                })
-                .collect(),
-        };
-        v.extend(requests.into_iter().map(Sample::Command));
+    let mut v: Vec<Sample> = Function::ALL
+        .into_iter()
+        .flat_map(|f| requests(f).into_iter().map(Sample::Command))
+        .collect();
+    v.extend(replies());
+    v
+}
+
+/// The command `f` with samples of its values (its value tables whole, its numbers at
+/// zero, typical values and the ends of their ranges).
+fn requests(f: Function) -> Vec<Request> {
+    // Exhaustive: a new command breaks the build here until it has samples.
+    match f {
+        Function::SetMode => Mode::ALL.iter().map(|m| Request::SetMode(*m)).collect(),
+        Function::SetPressure => [0, 5_000_000, -101_325, i32::MAX, i32::MIN]
+            .iter()
+            .map(|pa| Request::SetPressure { pa: *pa })
+            .collect(),
+        Function::SetSpeed => [0, 1_234, -52_360, i32::MAX, i32::MIN]
+            .iter()
+            .map(|m| Request::SetSpeed { mrad_s: *m })
+            .collect(),
+        Function::ClearFaults => vec![Request::ClearFaults],
+        Function::Heartbeat => vec![Request::Heartbeat],
+        Function::SetParameter => ParamId::ALL
+            .iter()
+            .map(|id| Request::SetParameter {
+                id: *id,
+                // A value inside the bounds that is not a round number.
+                value: id.min() + (id.max() - id.min()) * 0.3141,
+            })
+            .collect(),
+        Function::GetParameter => ParamId::ALL
+            .iter()
+            .map(|id| Request::GetParameter { id: *id })
+            .collect(),
+        Function::SaveParameters => vec![Request::SaveParameters],
+        Function::StepTest => StepLoop::ALL
+            .iter()
+            .zip([(-2.5f32, 1u16), (12.75, 250), (1.5e6, 65_535)])
+            .map(|(l, (a, ms))| Request::StepTest {
+                target: *l,
+                amplitude: a,
+                duration_ms: ms,
+            })
+            .collect(),
+        Function::Commission => vec![Request::Commission],
+        Function::CompensationBin => vec![
+            Request::CompensationHeader {
+                exponents: [19, 40, -3],
+                bins: 512,
+            },
+            Request::CompensationBin {
+                bin: 0,
+                raw: [0, 0, 0],
+            },
+            Request::CompensationBin {
+                bin: 511,
+                raw: [i16::MIN, -1234, i16::MAX],
+            },
+        ],
+        Function::CompensationCommit => [0u32, 0x8123_FB45, u32::MAX]
+            .iter()
+            .map(|crc| Request::CompensationCommit { crc: *crc })
+            .collect(),
+        Function::CompensationSweep => [(10.0f32, 6000u16), (-2.5, 1), (1e3, 65_535)]
+            .iter()
+            .map(|(w, ms)| Request::CompensationSweep {
+                speed_rad_s: *w,
+                leg_ms: *ms,
+            })
+            .collect(),
     }
+}
+
+/// Every reply: a status in every mode, with every fault code and after every command;
+/// every rejection of every command; every parameter; the diagnostics' extremes.
+fn replies() -> Vec<Sample> {
+    let mut v = Vec::new();
     let mut status = |mode: Mode, fault: u8, kpa: i16, drad: i16, last: u8, seq: u8| {
         v.push(Sample::Reply(Reply::Status(Status {
             mode: mode.code(),

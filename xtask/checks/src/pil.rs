@@ -31,18 +31,7 @@ const COMPARED: [&str; 4] = ["p_pa", "speed_rad_s", "iq_a", "id_a"];
 /// Builds, runs, decodes, ingests, compares, reports, and checks the budget.
 pub fn pil() -> Result<()> {
     let qemu = "qemu-system-arm";
-    if Command::new(qemu)
-        .arg("--version")
-        .stdout(Stdio::null())
-        .status()
-        .is_err()
-    {
-        bail!(
-            "{qemu} is missing: the PIL runs the control code on QEMU's Cortex-M4F \
-             (mps2-an386). Install it with `apt-get install qemu-system-arm` (Debian/Ubuntu; \
-             `apt-get update` first on a fresh machine)"
-        );
-    }
+    require(qemu)?;
     xtask::images::build("PIL image (warnings denied)", "pil")?;
 
     let target_dir = xtask::workspace::target_dir();
@@ -71,37 +60,8 @@ pub fn pil() -> Result<()> {
         );
     }
 
-    let eha_bin = xtask::workspace::eha_binary("eha for the PIL comparison")?;
-    let pil_csv = out_dir.join("pil.csv");
-    let host_csv = out_dir.join("host.csv");
-    xtask::workspace::run(
-        "eha ingest (PIL telemetry)",
-        eha(&eha_bin).args([
-            "ingest",
-            path_str(&defmt_log)?,
-            "--out",
-            path_str(&pil_csv)?,
-        ]),
-    )?;
-    crate::watch_check::check(&eha_bin, &defmt_log, &pil_csv, &out_dir)?;
-    xtask::workspace::run(
-        "eha simulate (same scenario on the host)",
-        eha(&eha_bin).args([
-            "simulate",
-            "--scenario",
-            SCENARIO,
-            "--duration",
-            DURATION_S,
-            "--seed",
-            SEED,
-            "--out",
-            path_str(&host_csv)?,
-        ]),
-    )?;
-    let target_log = read_log(&pil_csv)?;
-    let host_log = read_log(&host_csv)?;
+    let (target_log, host_log) = both_runs(&defmt_log, &out_dir)?;
     let diffs = compare(&target_log, &host_log)?;
-
     let current = figure(&figures, "current_loop_instructions")?;
     let (budget, goal) = budget()?;
     let stack_peak = figure(&figures, "stack_peak_bytes")?;
@@ -109,7 +69,6 @@ pub fn pil() -> Result<()> {
     // less the static-RAM budget); the image's own figure is reported beside it.
     let firmware_stack_min =
         (crate::firmware_image::FIRMWARE_RAM - crate::firmware_image::RAM_BUDGET) as f64;
-    let firmware_stack = firmware_stack_bytes();
     let stack_margin = firmware_stack_min / stack_peak.max(1.0);
     let report = serde_json::json!({
         "current_loop_instructions": current,
@@ -129,20 +88,7 @@ pub fn pil() -> Result<()> {
         "current_loop_budget_instructions": budget,
         "current_loop_goal_instructions": goal,
         "qemu_wall_s": wall_s,
-        "stack": {
-            "pil_peak_bytes": stack_peak,
-            "pil_region_bytes": figure(&figures, "stack_size_bytes")?,
-            "closed_loop_step_bytes": figure(&figures, "closed_loop_step_stack_bytes")?,
-            "telemetry_emit_bytes": figure(&figures, "telemetry_emit_stack_bytes")?,
-            "firmware_boot_bytes": figure(&figures, "boot_stack_bytes")?,
-            "parameter_save_bytes": figure(&figures, "parameter_save_stack_bytes")?,
-            "can_serve_bytes": figure(&figures, "can_serve_stack_bytes")?,
-            "harness_setup_bytes": figure(&figures, "harness_setup_stack_bytes")?,
-            "firmware_stack_min_bytes": firmware_stack_min,
-            "firmware_stack_bytes": firmware_stack,
-            "margin": stack_margin,
-            "margin_min": STACK_MARGIN_MIN,
-        },
+        "stack": stack_report(&figures, firmware_stack_min, stack_margin)?,
     });
     let report_path = out_dir.join("report.json");
     fs::write(&report_path, format!("{report:#}\n"))?;
@@ -166,6 +112,81 @@ pub fn pil() -> Result<()> {
              {STACK_MARGIN_MIN}"
         );
     }
+    check_budget(current, budget, goal)
+}
+
+/// Fails unless `qemu` runs, saying how to install it.
+fn require(qemu: &str) -> Result<()> {
+    if Command::new(qemu)
+        .arg("--version")
+        .stdout(Stdio::null())
+        .status()
+        .is_err()
+    {
+        bail!(
+            "{qemu} is missing: the PIL runs the control code on QEMU's Cortex-M4F \
+             (mps2-an386). Install it with `apt-get install qemu-system-arm` (Debian/Ubuntu; \
+             `apt-get update` first on a fresh machine)"
+        );
+    }
+    Ok(())
+}
+
+/// The PIL run's telemetry (`defmt_log`) as a bench log by `eha ingest`, checked in
+/// `eha watch`, and the same scenario simulated on the host by `eha simulate`; both logs
+/// written into `out_dir` and read back.
+fn both_runs(defmt_log: &Path, out_dir: &Path) -> Result<(Log, Log)> {
+    let eha_bin = xtask::workspace::eha_binary("eha for the PIL comparison")?;
+    let pil_csv = out_dir.join("pil.csv");
+    let host_csv = out_dir.join("host.csv");
+    xtask::workspace::run(
+        "eha ingest (PIL telemetry)",
+        eha(&eha_bin).args(["ingest", path_str(defmt_log)?, "--out", path_str(&pil_csv)?]),
+    )?;
+    crate::watch_check::check(&eha_bin, defmt_log, &pil_csv, out_dir)?;
+    xtask::workspace::run(
+        "eha simulate (same scenario on the host)",
+        eha(&eha_bin).args([
+            "simulate",
+            "--scenario",
+            SCENARIO,
+            "--duration",
+            DURATION_S,
+            "--seed",
+            SEED,
+            "--out",
+            path_str(&host_csv)?,
+        ]),
+    )?;
+    Ok((read_log(&pil_csv)?, read_log(&host_csv)?))
+}
+
+/// The report's stack figures: the PIL run's peak and region, each measured part's, and
+/// the firmware's stack against the run's peak (`margin`, at least [`STACK_MARGIN_MIN`]).
+fn stack_report(
+    figures: &BTreeMap<String, f64>,
+    firmware_stack_min: f64,
+    margin: f64,
+) -> Result<serde_json::Value> {
+    Ok(serde_json::json!({
+        "pil_peak_bytes": figure(figures, "stack_peak_bytes")?,
+        "pil_region_bytes": figure(figures, "stack_size_bytes")?,
+        "closed_loop_step_bytes": figure(figures, "closed_loop_step_stack_bytes")?,
+        "telemetry_emit_bytes": figure(figures, "telemetry_emit_stack_bytes")?,
+        "firmware_boot_bytes": figure(figures, "boot_stack_bytes")?,
+        "parameter_save_bytes": figure(figures, "parameter_save_stack_bytes")?,
+        "can_serve_bytes": figure(figures, "can_serve_stack_bytes")?,
+        "harness_setup_bytes": figure(figures, "harness_setup_stack_bytes")?,
+        "firmware_stack_min_bytes": firmware_stack_min,
+        "firmware_stack_bytes": firmware_stack_bytes(),
+        "margin": margin,
+        "margin_min": STACK_MARGIN_MIN,
+    }))
+}
+
+/// Fails when the current-loop step's instruction count `current` exceeds its ceiling
+/// `goal` or its recorded `budget` by more than [`BUDGET_TOLERANCE_PERCENT`].
+fn check_budget(current: f64, budget: f64, goal: f64) -> Result<()> {
     if current > goal {
         bail!(
             "the current-loop step takes {current:.0} instructions, above its ceiling of \
