@@ -18,7 +18,8 @@
 //! Each test yields the generalised likelihood ratio Λ on the identification segment (the
 //! objectives' difference for a released parameter, the line's power for a line), its
 //! degrees of freedom, the parameter's estimate with its standard error, and the gain on
-//! the validation segment in the same units.
+//! the validation segment in the same units. A relation's releases are read into that
+//! form by `release_verdict`; the lines' and the dead time's tests are read here.
 
 use crate::diagnose::angle_locked::{
     fit_line, line_gain, offset_from_line, plant_phase, LineEffect, LineFit, LineReading,

@@ -17,7 +17,9 @@
 //!   windows and the effects that make them; [`loop_response`]: the Table 1 loops'
 //!   responses the line readings use; [`emf_law`]: the 6·p_n voltage lines read as a
 //!   back-EMF and as a dead time's voltage.
-//! - [`candidates`], [`decision`]: every effect tested, and the one the log convicts.
+//! - [`candidates`], [`decision`]: every effect tested, and the one the log convicts;
+//!   `release_verdict`: a released parameter's test read in the catalogue's terms (its
+//!   band, the validation's spread, the vetoes).
 //! - [`displacement`]: the pump's displacement fixed by the torque balance and the stator
 //!   voltages, at which a blocked cylinder's leakage and bulk modulus are read.
 //! - [`predictions`]: the contract's per-signal predictions and scores ([`fit_score`]).
