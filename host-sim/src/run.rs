@@ -12,14 +12,14 @@
 use crate::bench_log::limits::{max_rows, physical_range};
 use crate::bench_log::BenchLog;
 use crate::feedforward::Feedforward;
+use crate::output::progress::percent;
 use closed_loop::{controller_config, ClosedLoop, Scenario};
 use firmware::config::Config;
 use firmware::parameters::ParamId;
 use firmware::Command;
-use indicatif::{ProgressBar, ProgressStyle};
 use plant_model::accumulator::Absorber;
 use plant_model::{Integrator, Rig};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// What a run produced.
 pub struct Run {
@@ -162,7 +162,8 @@ pub fn run_with_config(
     let mut cols: [Vec<f64>; 8] = Default::default();
     let mut p_true = Vec::with_capacity(n_rows);
     let mut w_true = Vec::with_capacity(n_rows);
-    let bar = (opt.progress && opt.duration_s > 20.0).then(|| progress_bar(n_rows, scenario.name));
+    let bar =
+        (opt.progress && opt.duration_s > 20.0).then(|| percent(n_rows as u64, scenario.name));
     let started = Instant::now();
     let cpu_started = thread_cpu_s();
     let mut k = 0u64;
@@ -223,18 +224,6 @@ pub fn run_with_config(
         real_time_factor: opt.duration_s / wall.max(1e-9),
         cpu_real_time_factor: opt.duration_s / cpu.max(1e-9),
     })
-}
-
-/// The run's progress bar over `rows` logged rows, labelled `name`.
-fn progress_bar(rows: usize, name: &'static str) -> ProgressBar {
-    let b = ProgressBar::new(rows as u64);
-    b.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b.set_message(name);
-    b.enable_steady_tick(Duration::from_millis(200));
-    b
 }
 
 /// The absorber's natural frequency [Hz] and damping ratio [1] at the mean of the true

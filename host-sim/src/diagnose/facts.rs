@@ -11,7 +11,7 @@ use crate::bench_log::{BenchLog, Signal};
 pub use crate::diagnose::low_side::LowSide;
 use crate::diagnose::speed_angle::{integrated_angle, AngleSource};
 use crate::diagnose::steady::{
-    balanced_boundary, lesser_side, slow_line_speed, steady_windows, SteadyWindow,
+    balanced_boundary, lesser_side, slow_line_speed, slow_windows, steady_windows, SteadyWindow,
     STEADY_MIN_REVOLUTIONS,
 };
 use crate::diagnose::{line_split, low_side, unseen_motion};
@@ -235,11 +235,8 @@ fn segment_split(t: &[f64], theta: &[f64], period_s: f64, rig: &Rig) -> usize {
         t.partition_point(|x| *x < t_f).clamp(1, rows - 1)
     };
     let limit = slow_line_speed(period_s, rig);
-    let slow: Vec<SteadyWindow> = steady_windows(t, theta, period_s)
-        .into_iter()
-        .filter(|w| w.speed_rad_s.abs() < limit)
-        .collect();
-    let slow: Vec<&SteadyWindow> = slow.iter().collect();
+    let windows = steady_windows(t, theta, period_s);
+    let slow = slow_windows(&windows, limit);
     let middle = at(0.5);
     let (lo, hi) = (at(0.5 - SPLIT_REACH), at(0.5 + SPLIT_REACH));
     let (best, score) = balanced_boundary(&slow, middle, lo..=hi);

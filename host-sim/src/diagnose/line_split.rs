@@ -8,7 +8,8 @@
 //! middle of a slow stretch that made one window only.
 
 use crate::diagnose::steady::{
-    lesser_side, slow_line_speed, steady_windows, SteadyWindow, STEADY_MIN_REVOLUTIONS,
+    better_boundary, lesser_side, slow_line_speed, slow_windows, steady_windows, SteadyWindow,
+    STEADY_MIN_REVOLUTIONS,
 };
 use plant_model::Rig;
 
@@ -28,13 +29,8 @@ pub fn divided_windows(
 ) -> (Vec<SteadyWindow>, usize) {
     let limit = slow_line_speed(period_s, rig);
     let at = |b: usize| windows_at(t, theta, period_s, b, start);
-    let slow_lesser = |windows: &[SteadyWindow], b: usize| {
-        let slow: Vec<&SteadyWindow> = windows
-            .iter()
-            .filter(|w| w.speed_rad_s.abs() < limit)
-            .collect();
-        lesser_side(&slow, b)
-    };
+    let slow_lesser =
+        |windows: &[SteadyWindow], b: usize| lesser_side(&slow_windows(windows, limit), b);
     let windows = at(split);
     if slow_lesser(&windows, split) >= STEADY_MIN_REVOLUTIONS {
         return (windows, split);
@@ -55,10 +51,10 @@ pub fn divided_windows(
     {
         let w = at(b);
         let score = slow_lesser(&w, b);
-        let better = best.as_ref().is_none_or(|(b0, s0, _)| {
-            score > *s0 || (score == *s0 && b.abs_diff(split) < b0.abs_diff(split))
-        });
-        if better {
+        if best
+            .as_ref()
+            .is_none_or(|(b0, s0, _)| better_boundary((b, score), (*b0, *s0), split))
+        {
             best = Some((b, score, w));
         }
     }

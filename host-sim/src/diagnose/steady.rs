@@ -54,6 +54,21 @@ pub fn slow_line_speed(period_s: f64, rig: &Rig) -> f64 {
     2.0 * PI / period_s / 3.0 / highest
 }
 
+/// The windows slower than `limit` (those whose every line is read: [`slow_line_speed`]).
+/// [rad/s]
+pub fn slow_windows(windows: &[SteadyWindow], limit: f64) -> Vec<&SteadyWindow> {
+    windows
+        .iter()
+        .filter(|w| w.speed_rad_s.abs() < limit)
+        .collect()
+}
+
+/// Whether the boundary `c` (row, revolutions on its lesser side) beats `best`: more
+/// revolutions, or as many and closer to `middle`.
+pub fn better_boundary(c: (usize, f64), best: (usize, f64), middle: usize) -> bool {
+    c.1 > best.1 || (c.1 == best.1 && c.0.abs_diff(middle) < best.0.abs_diff(middle))
+}
+
 /// Revolutions of `windows` on the lesser side of the boundary `split` (windows across it
 /// count on neither side). [1]
 pub fn lesser_side(windows: &[&SteadyWindow], split: usize) -> f64 {
@@ -81,8 +96,7 @@ pub fn balanced_boundary(
         .filter(|s| reach.contains(s))
         .map(|s| (s, lesser_side(windows, s)))
         .fold((middle, lesser_side(windows, middle)), |b, c| {
-            let closer = c.0.abs_diff(middle) < b.0.abs_diff(middle);
-            if c.1 > b.1 || (c.1 == b.1 && closer) {
+            if better_boundary(c, b, middle) {
                 c
             } else {
                 b

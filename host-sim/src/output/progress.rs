@@ -16,6 +16,18 @@ pub fn spinner(message: String) -> ProgressBar {
     b
 }
 
+/// A bar of `len` units with `message`, the share done in per cent and the elapsed time.
+pub fn percent(len: u64, message: &str) -> ProgressBar {
+    let b = ProgressBar::new(len);
+    b.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message(message.to_string());
+    b.enable_steady_tick(Duration::from_millis(200));
+    b
+}
+
 /// A bar of `steps` steps with `message`, the step under way and the elapsed time.
 pub fn steps(steps: u64, message: String) -> ProgressBar {
     let b = ProgressBar::new(steps);

@@ -34,12 +34,11 @@ impl Cut {
     /// logged times and the log's metadata ([`BenchLog::rows`]).
     pub fn apply(self, log: &BenchLog) -> BenchLog {
         let n = log.len();
-        let (share, first) = match self {
-            Cut::First(s) => (s, true),
-            Cut::Last(s) => (s, false),
-        };
-        let keep = ((share * n as f64) as usize).clamp(2.min(n), n);
-        log.rows(if first { 0..keep } else { n - keep..n })
+        let keep = |share: f64| ((share * n as f64) as usize).clamp(2.min(n), n);
+        log.rows(match self {
+            Cut::First(s) => 0..keep(s),
+            Cut::Last(s) => n - keep(s)..n,
+        })
     }
 }
 
