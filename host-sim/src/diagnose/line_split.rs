@@ -162,8 +162,19 @@ mod tests {
         let rig = Rig::nominal();
         let (t, theta) = turning(12.0, |t| if t < 2.0 { 180.0 } else { 7.0 });
         let split = t.len() / 2;
+        let limit = slow_line_speed(1e-3, &rig);
         let (windows, b) = divided_windows(&t, &theta, 1e-3, &rig, split, 0);
         assert_eq!(b, split);
-        assert_eq!(windows, windows_at(&t, &theta, 1e-3, split, 0));
+        // 7 rad/s from 2 s to the middle at 6 s and on to 12 s: 4 s (4.46 revolutions)
+        // before, 6 s (6.68) after, each less at most a remainder too short for a window
+        // (under one revolution) and a 0.1 s chunk cut at the speed change or the end.
+        let (before, after) = slow_each_side(&windows, b, limit);
+        let turns = |s: f64| 7.0 * s / (2.0 * PI);
+        let lost = STEADY_MIN_REVOLUTIONS + turns(0.1);
+        assert!(
+            before <= turns(4.0) && before >= turns(4.0) - lost,
+            "{before}"
+        );
+        assert!(after <= turns(6.0) && after >= turns(6.0) - lost, "{after}");
     }
 }
