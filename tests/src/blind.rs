@@ -44,17 +44,18 @@ pub use observability::{
 pub use structure::{ControllerVariant, Structure};
 pub use test_plan::{TestKind, FAST_RATES_HZ, LENGTH_S, RATES_HZ, TESTS};
 
-use closed_loop::{controller_config, Scenario};
-use host_sim::bench_log::{self, BenchLog};
-use host_sim::run::{run_with_config, RunOptions};
-use plant_model::{Effect, Rig};
-use rand_core::{RngCore, SeedableRng};
-use rand_xoshiro::Xoshiro256PlusPlus;
+use host_sim::bench_log;
+use plant_model::Rig;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 mod coverage;
+mod drawn;
+mod stream;
 pub use coverage::{COVERAGE, NEVER_SHOWS};
+pub use drawn::{Draw, Hidden, Truth};
+use stream::Stream;
+pub use stream::TOLERANCE;
 
 /// Seeds of the false-alarm set: every one hides nothing, in the test `seed mod 4` of
 /// [`TESTS`], on a rig drawn like the others (tolerances, structure, controller, columns,
@@ -71,9 +72,6 @@ pub fn identification_seeds() -> Range<u64> {
     0..COVERAGE.len() as u64
 }
 
-/// Relative tolerance of every perturbed rig parameter: uniform in ±this. [1]
-pub const TOLERANCE: f64 = 0.03;
-
 /// Share of freely drawn logs hiding nothing, and hiding one effect (the rest hide a pair). [1]
 const FREE_SHARES: (f64, f64) = (0.15, 0.5);
 
@@ -87,168 +85,6 @@ const MAGNITUDE_TRIES: usize = 3;
 
 /// Frames drawn for one seed before the generator gives up.
 const FRAME_TRIES: usize = 4;
-
-/// One hidden effect: the answer for it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Hidden {
-    /// Effect name from the catalogue.
-    pub name: &'static str,
-    /// Its parameters by their contract names (SI), as applied to the plant.
-    pub parameters: Vec<(&'static str, f64)>,
-    /// The logged signal where its signature stands highest over the noise.
-    pub signal: &'static str,
-    /// That signature over the noise. [1]
-    pub ratio: f64,
-}
-
-/// What the generator hid in one log: the answer the suite checks the diagnosis against.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Truth {
-    /// The hidden effects (empty: nothing hidden), in the order they were drawn.
-    pub effects: Vec<Hidden>,
-    /// The test the log records (a name of [`TESTS`]).
-    pub test: &'static str,
-    /// Log rate. [Hz]
-    pub log_rate_hz: f64,
-    /// Length of the log. [s]
-    pub duration_s: f64,
-    /// The contract's optional columns the log does not hold.
-    pub dropped: Vec<&'static str>,
-}
-
-impl Truth {
-    /// `none`, the effect's name, or the two names in alphabetical order joined by `+` (the
-    /// label of `truth.json`).
-    pub fn label(&self) -> String {
-        let mut names: Vec<&str> = self.effects.iter().map(|h| h.name).collect();
-        names.sort_unstable();
-        if names.is_empty() {
-            "none".into()
-        } else {
-            names.join("+")
-        }
-    }
-}
-
-/// Everything drawn for one seed: the truth plus how to simulate it. Kept inside the
-/// generator and the suite's own checks; the diagnosis gets only the written log.
-#[derive(Clone, Debug)]
-pub struct Draw {
-    /// The answer.
-    pub truth: Truth,
-    /// The hidden effects (with their parameters).
-    pub effects: Vec<Effect>,
-    /// The plant's rig: nominal ± tolerances with the drawn structure, WITHOUT the effects.
-    pub tolerance_rig: Rig,
-    /// What was drawn beyond the tolerances: open parts of the rig, the controller's
-    /// tuning, the columns not logged (already in `tolerance_rig` where it is the rig's).
-    pub structure: Structure,
-    /// The bench's low-side pressure transducer.
-    pub low_side: LowSideTransducer,
-    /// The test, with its drawn setpoints and length.
-    pub scenario: Scenario,
-    /// Log rate. [Hz]
-    pub log_rate_hz: f64,
-    /// Sensor-noise seed of the plant and the bench's extra sensors.
-    pub noise_seed: u64,
-    /// File-name token (drawn, so the name carries nothing about the seed).
-    token: u64,
-}
-
-/// `rig` with the white noise of every sensor off (quantisation stays).
-fn noise_free(rig: &Rig) -> Rig {
-    let mut r = rig.clone();
-    r.sensors.current.noise_a_rms = 0.0;
-    r.sensors.pressure.noise_pa_rms = 0.0;
-    r.sensors.dc_link.noise_v_rms = 0.0;
-    r
-}
-
-impl Draw {
-    /// The plant's true rig: the tolerance rig with every hidden effect switched on.
-    pub fn truth_rig(&self) -> Rig {
-        let mut rig = self.tolerance_rig.clone();
-        for e in &self.effects {
-            e.apply(&mut rig);
-        }
-        rig
-    }
-
-    /// The true rig without the `k`-th hidden effect (the others on).
-    pub fn rig_without(&self, k: usize) -> Rig {
-        let mut rig = self.tolerance_rig.clone();
-        for (i, e) in self.effects.iter().enumerate() {
-            if i != k {
-                e.apply(&mut rig);
-            }
-        }
-        rig
-    }
-
-    /// The draw's test run on the plant `rig` under the draw's controller (the nominal
-    /// rig's, tuned by the drawn variant), logged at the draw's rate with every column,
-    /// the bench's extra sensors read through; with every sensor's noise seeded by `noise`
-    /// (the truth's is [`Draw::noise_seed`]), or with their quantisation only when `None`.
-    pub fn log(&self, rig: &Rig, noise: Option<u64>) -> Result<BenchLog, String> {
-        let plant = if noise.is_some() {
-            rig.clone()
-        } else {
-            noise_free(rig)
-        };
-        let opt = RunOptions {
-            duration_s: self.scenario.duration_s,
-            log_rate_hz: self.log_rate_hz,
-            seed: noise.unwrap_or(self.noise_seed),
-            progress: false,
-            metadata: vec![("source".into(), "blind-suite".into())],
-            compensation: None,
-            integrator: Default::default(),
-        };
-        let config = self
-            .structure
-            .controller
-            .apply(&controller_config(&Rig::nominal()));
-        let mut log = run_with_config(&plant, &config, &self.scenario, &opt)?.log;
-        let extra = noise.map(|n| n ^ 0x5851_f42d_4c95_7f2d);
-        read_through(&mut log, &self.low_side, extra);
-        Ok(log)
-    }
-}
-
-/// Uniform deviates from the generator's own xoshiro stream.
-pub(crate) struct Stream(Xoshiro256PlusPlus);
-
-impl Stream {
-    /// Uniform in [0, 1) from the top 53 bits.
-    fn unit(&mut self) -> f64 {
-        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [lo, hi).
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    /// `x` scaled by a factor uniform in 1 ± [`TOLERANCE`].
-    fn tolerance(&mut self, x: f64) -> f64 {
-        x * self.uniform(1.0 - TOLERANCE, 1.0 + TOLERANCE)
-    }
-
-    /// One of `items`, uniformly.
-    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
-        let k = (self.unit() * items.len() as f64) as usize;
-        items[k.min(items.len() - 1)]
-    }
-
-    /// +1 or −1 with equal probability.
-    fn sign(&mut self) -> f64 {
-        if self.unit() < 0.5 {
-            -1.0
-        } else {
-            1.0
-        }
-    }
-}
 
 /// The nominal rig with every parameter that is a manufacturing or operating tolerance
 /// (not a fault) scaled by an independent factor uniform in 1 ± 3 %: motor R_s, L_d, L_q,
@@ -296,7 +132,7 @@ fn tolerance_rig(s: &mut Stream) -> Rig {
 /// A bench of the nominal design built within its tolerances ([`tolerance_rig`]), drawn
 /// from a stream of its own seeded with `seed`: the fleet generator's drives.
 pub fn seeded_tolerance_rig(seed: u64) -> Rig {
-    tolerance_rig(&mut Stream(Xoshiro256PlusPlus::seed_from_u64(seed)))
+    tolerance_rig(&mut Stream::seeded(seed))
 }
 
 /// The optional columns without which the hidden `effects` cannot be seen in `test`: on a
@@ -385,8 +221,8 @@ fn frame(seed: u64, s: &mut Stream) -> Draw {
     let mut tolerance_rig = tolerance_rig(s);
     let scenario = test_plan::draw_test(s, test);
     let log_rate_hz = test_plan::draw_log_rate(s);
-    let noise_seed = s.0.next_u64();
-    let token = s.0.next_u64();
+    let noise_seed = s.next_u64();
+    let token = s.next_u64();
     let names: Vec<&'static str> = match fixed {
         Some(e) => e.to_vec(),
         None => draw_effect_names(s, test),
@@ -446,7 +282,7 @@ fn with_magnitudes(d: &Draw, names: &[&'static str], s: &mut Stream) -> Draw {
 /// free seed draws everything again), up to [`FRAME_TRIES`] frames. A coverage seed whose
 /// effects never show is an error: its row claims what the test cannot show.
 pub fn draw(seed: u64) -> Result<(Draw, Checked), String> {
-    let mut s = Stream(Xoshiro256PlusPlus::seed_from_u64(seed));
+    let mut s = Stream::seeded(seed);
     let mut tried = Vec::new();
     let mut test = "";
     for _ in 0..FRAME_TRIES {
@@ -481,7 +317,7 @@ pub fn draw(seed: u64) -> Result<(Draw, Checked), String> {
 /// length, dropped columns and effect names of its first frame (which [`draw`] replaces
 /// when no magnitude shows in it); no parameters or signals yet.
 pub fn outline(seed: u64) -> Truth {
-    let mut s = Stream(Xoshiro256PlusPlus::seed_from_u64(seed));
+    let mut s = Stream::seeded(seed);
     frame(seed, &mut s).truth
 }
 

@@ -5,8 +5,8 @@
 //! [`acts_differently`]). Whether a drawn magnitude shows in the log is measured afterwards
 //! ([`super::observability::check`]).
 
+use super::stream::Stream;
 use super::test_plan::TestKind;
-use super::Stream;
 use plant_model::pump::kinematic_ripple_ratio;
 use plant_model::{Effect, Rig};
 use std::f64::consts::TAU;

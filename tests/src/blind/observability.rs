@@ -18,7 +18,7 @@
 //! fails either is drawn again.
 
 use super::catalogue::halfway;
-use super::Draw;
+use super::drawn::Draw;
 use host_sim::bench_log::{BenchLog, Signal};
 
 /// How far above the noise an effect must stand on some logged signal to be kept. [1]

@@ -13,7 +13,7 @@
 //! Each range is one a healthy rig has: a variant is not a fault, and the diagnosis must
 //! call such a rig `none`.
 
-use super::Stream;
+use super::stream::Stream;
 use firmware::config::Config;
 use host_sim::bench_log::{BenchLog, Signal};
 use plant_model::Rig;

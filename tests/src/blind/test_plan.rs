@@ -16,7 +16,7 @@
 //! Lengths 15 to 40 s; log rates 500 Hz, 1 kHz or 2 kHz, one log in five at 5 or 10 kHz
 //! (whole divisors of the drive's 20 kHz PWM, as a telemetry decimation is).
 
-use super::Stream;
+use super::stream::Stream;
 use closed_loop::bench_test::{sine_test, staircase_test, step_test, stroke_test, SETTLE_S};
 use closed_loop::Scenario;
 
