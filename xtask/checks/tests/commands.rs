@@ -72,6 +72,8 @@ fn rooms_names_a_file_over_the_limit() {
         "plant-model",
         "host-sim",
         "closed-loop",
+        "tests",
+        "pil",
         "xtask",
         "xtask/checks",
     ];
@@ -84,9 +86,16 @@ fn rooms_names_a_file_over_the_limit() {
         .map(|i| format!("pub const C{i}: u32 = {i};\n"))
         .collect();
     std::fs::write(dir.path().join("host-sim/src/lib.rs"), long).unwrap();
+    // An integration test is held to the same length; one at the limit is not named.
+    let tests = dir.path().join("host-sim/tests");
+    std::fs::create_dir_all(&tests).unwrap();
+    std::fs::write(tests.join("long.rs"), "#[test]\nfn t() {}\n".repeat(326)).unwrap();
+    std::fs::write(tests.join("at.rs"), "// a line\n".repeat(650)).unwrap();
     let out = checks(&["rooms", "--root", dir.path().to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1), "{out:?}");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("  700  host-sim/src/lib.rs"), "{text}");
+    assert!(text.contains("  652  host-sim/tests/long.rs"), "{text}");
+    assert!(!text.contains("at.rs"), "{text}");
     assert_eq!(text.matches("lib.rs").count(), 1, "{text}");
 }

@@ -47,14 +47,20 @@ impl Findings {
     }
 }
 
-/// Checks each crate whose `src/` folder is in `srcs`, with files over `limit` lines long.
-pub fn check(srcs: &[PathBuf], limit: usize) -> Result<Findings> {
+/// Checks each crate whose `src/` folder is in `srcs`, and the length alone of the files
+/// below each folder of `measured`, with files over `limit` lines long.
+pub fn check(srcs: &[PathBuf], measured: &[PathBuf], limit: usize) -> Result<Findings> {
     let mut findings = Findings::default();
     for src in srcs {
         let files = rust_files(src)?;
         findings.files += files.len();
         findings.long_files.extend(long_files(&files, limit));
         findings.circles.extend(crate_circles(src)?);
+    }
+    for folder in measured {
+        let files = rust_files(folder)?;
+        findings.files += files.len();
+        findings.long_files.extend(long_files(&files, limit));
     }
     Ok(findings)
 }

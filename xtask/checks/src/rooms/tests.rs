@@ -57,7 +57,7 @@ fn a_true_circle_is_found_with_the_names_that_tie_it() {
             ("c.rs", "pub fn go() { crate::b::take(crate::a::A); }\n"),
         ],
     );
-    let found = check(std::slice::from_ref(&src), 650).unwrap();
+    let found = check(std::slice::from_ref(&src), &[], 650).unwrap();
     assert_eq!(found.files, 4);
     assert!(found.long_files.is_empty());
     assert_eq!(
@@ -110,7 +110,7 @@ fn a_re_export_leads_to_the_defining_file_and_is_no_circle() {
             e("shapes/square.rs", "shapes/circle.rs", &["Circle"]),
         ]
     );
-    assert!(check(&[src], 650).unwrap().clean());
+    assert!(check(&[src], &[], 650).unwrap().clean());
 }
 
 #[test]
@@ -136,7 +136,7 @@ fn test_only_code_is_left_out() {
         ],
     );
     assert_eq!(edges(&src), vec![e("b.rs", "a.rs", &["a"])]);
-    let found = check(&[src], 650).unwrap();
+    let found = check(&[src], &[], 650).unwrap();
     assert!(found.circles.is_empty());
     // The test file is still counted as a source file (lines under src/ count).
     assert_eq!(found.files, 4);
@@ -171,7 +171,7 @@ fn super_paths_climb_the_module_tree() {
             e("outer/inner.rs", "outer.rs", &["Shared"]),
         ]
     );
-    let found = check(std::slice::from_ref(&src), 650).unwrap();
+    let found = check(std::slice::from_ref(&src), &[], 650).unwrap();
     assert_eq!(found.circles.len(), 1);
     // Paths sort by component: `outer/inner.rs` before `outer.rs`.
     assert_eq!(
@@ -216,13 +216,32 @@ fn files_over_the_limit_are_listed() {
             ("over.rs", &over),
         ],
     );
-    let found = check(std::slice::from_ref(&src), 10).unwrap();
+    let found = check(std::slice::from_ref(&src), &[], 10).unwrap();
     assert_eq!(found.files, 3);
     assert_eq!(found.long_files.len(), 1);
     assert_eq!(found.long_files[0].path, src.join("over.rs"));
     assert_eq!(found.long_files[0].lines, 11);
     assert!(found.circles.is_empty());
     assert!(!found.clean());
+}
+
+#[test]
+fn measured_folders_count_for_length_only() {
+    // An integration test's folder: a long file, a module of it in a subfolder, and text
+    // that is no Rust at all (the folder is never parsed, so it cannot fail the check).
+    let dir = tempfile::tempdir().unwrap();
+    let tests = dir.path().join("tests");
+    std::fs::create_dir_all(tests.join("big")).unwrap();
+    std::fs::write(tests.join("short.rs"), "// a line\n".repeat(10)).unwrap();
+    std::fs::write(tests.join("big/main.rs"), "not rust {\n".repeat(11)).unwrap();
+    std::fs::write(tests.join("notes.txt"), "// a line\n".repeat(50)).unwrap();
+    let src = crate_with(dir.path(), &[("lib.rs", "pub fn f() {}\n")]);
+    let found = check(std::slice::from_ref(&src), std::slice::from_ref(&tests), 10).unwrap();
+    assert_eq!(found.files, 3, "lib.rs and the two .rs files below tests/");
+    assert_eq!(found.long_files.len(), 1);
+    assert_eq!(found.long_files[0].path, tests.join("big/main.rs"));
+    assert_eq!(found.long_files[0].lines, 11);
+    assert!(found.circles.is_empty());
 }
 
 #[test]
