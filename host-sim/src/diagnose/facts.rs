@@ -14,7 +14,6 @@ use crate::diagnose::steady::{
     balanced_boundary, lesser_side, slow_line_speed, slow_windows, steady_windows, SteadyWindow,
     STEADY_MIN_REVOLUTIONS,
 };
-use crate::diagnose::two_way::two_way_split;
 use crate::diagnose::{line_split, low_side, unseen_motion};
 use plant_model::Rig;
 use std::f64::consts::PI;
@@ -133,12 +132,6 @@ impl LogFacts {
         let piston_unseen =
             log.x_m.is_none() && unseen_motion::unseen_piston_motion(log, p_low, rig);
         let split = segment_split(t, &theta_rad, period_s, rig);
-        let split = if piston_moves {
-            let reach_end = at_fraction(t, 0.5 + SPLIT_REACH);
-            two_way_split(t, &theta_rad, period_s, split, reach_end)
-        } else {
-            split
-        };
         let start = t
             .partition_point(|x| *x < t[0] + START_SKIP_S)
             .min(split / 4);
@@ -236,7 +229,11 @@ pub const SPLIT_REACH: f64 = 0.2;
 /// [`SPLIT_REACH`] of the middle, to the end of the slow window that leaves the lesser side
 /// the most such revolutions (at least twice what the middle leaves it).
 fn segment_split(t: &[f64], theta: &[f64], period_s: f64, rig: &Rig) -> usize {
-    let at = |f: f64| at_fraction(t, f);
+    let rows = t.len();
+    let at = |f: f64| {
+        let t_f = t[0] + f * (t[rows - 1] - t[0]);
+        t.partition_point(|x| *x < t_f).clamp(1, rows - 1)
+    };
     let limit = slow_line_speed(period_s, rig);
     let windows = steady_windows(t, theta, period_s);
     let slow = slow_windows(&windows, limit);
@@ -248,14 +245,6 @@ fn segment_split(t: &[f64], theta: &[f64], period_s: f64, rig: &Rig) -> usize {
     } else {
         middle
     }
-}
-
-/// The first row at or after the fraction `f` of the log's duration (within the rows that
-/// leave both segments one row at least).
-fn at_fraction(t: &[f64], f: f64) -> usize {
-    let rows = t.len();
-    let t_f = t[0] + f * (t[rows - 1] - t[0]);
-    t.partition_point(|x| *x < t_f).clamp(1, rows - 1)
 }
 
 /// Rows spanning `seconds` at the sampling `period_s`, at least `min_rows`: the spans of

@@ -76,7 +76,6 @@ pub mod steady;
 pub mod stick;
 #[cfg(test)]
 mod test_noise;
-pub mod two_way;
 pub mod uneven_derivative;
 pub mod unseen_motion;
 pub mod validation_spread;
