@@ -56,10 +56,9 @@ pub fn from_release<R: Relation>(
     // is the profile likelihood ratio of the band's edge against the estimate — a test that
     // needs no covariance of the nuisance parameters, which flat bands leave singular along
     // the directions the log does not fix.
-    let outside_band = match base_specs[indices[0]].band {
-        Some((lo, hi)) => test.fitted.u[indices[0]] > hi || test.fitted.u[indices[0]] < lo,
-        None => false,
-    };
+    let u = test.fitted.u[indices[0]];
+    let band = base_specs[indices[0]].band;
+    let outside_band = band.is_some_and(|(lo, hi)| u > hi || u < lo);
     let parameters = parameters_at(test.release, v, rig);
     let validation_gain = (!validation.is_empty()).then(|| {
         weighed_sse(relation, &test.baseline.values, validation, test.scale)
@@ -98,12 +97,11 @@ pub fn from_release<R: Relation>(
     // range's edge legitimately: a cylinder's friction is bounded by the payload's force.)
     let main = &specs[indices[0]];
     let (lo, hi) = main.u_bounds;
-    let u = test.fitted.u[indices[0]];
     let at_top = hi > lo && hi - u <= SEARCH_EDGE * (hi - lo);
     // Entrained air only softens the oil (the catalogue's effect is a bulk modulus below the
     // rig file's): a reading above the band is a stiffness the log trades against the line
     // volume or another tolerance, not air.
-    let above_band = base_specs[indices[0]].band.is_some_and(|(_, top)| u > top);
+    let above_band = band.is_some_and(|(_, top)| u > top);
     let veto = release_veto(test.release, main, u, above_band, at_top);
     let mut evidence = release_evidence(test, &indices, &specs, &base_specs);
     if let (Some(g), Some(s)) = (validation_gain, validation_spread) {
