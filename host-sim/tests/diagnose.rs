@@ -473,25 +473,40 @@ fn a_log_without_the_angle_is_read_from_its_counted_speed() {
     );
 }
 
-/// `log` rewritten without the rows of `lost` (metadata and header kept), as a logger that
-/// dropped them writes it.
-fn without_rows(log: &std::path::Path, lost: impl Fn(usize) -> bool) -> PathBuf {
+/// `log` rewritten into `name` beside it, metadata and header kept, each data row `r`
+/// (from 0) replaced by what `row` makes of it (left out where it makes nothing).
+fn rewritten(
+    log: &std::path::Path,
+    name: &str,
+    mut row: impl FnMut(usize, &str) -> Option<String>,
+) -> PathBuf {
     let text = fs::read_to_string(log).unwrap();
     let mut out = String::new();
-    let mut row = None::<usize>;
+    let mut header_seen = false;
+    let mut r = 0;
     for line in text.lines() {
-        if !line.starts_with('#') {
-            row = Some(row.map_or(0, |r| r + 1));
-            if row.is_some_and(|r| r > 0 && lost(r - 1)) {
-                continue;
-            }
+        let kept = if line.starts_with('#') || !header_seen {
+            header_seen |= !line.starts_with('#');
+            Some(line.to_string())
+        } else {
+            r += 1;
+            row(r - 1, line)
+        };
+        if let Some(l) = kept {
+            out.push_str(&l);
+            out.push('\n');
         }
-        out.push_str(line);
-        out.push('\n');
     }
-    let path = log.with_file_name("dropped.csv");
+    let path = log.with_file_name(name);
     fs::write(&path, out).unwrap();
     path
+}
+
+/// `log` without the rows of `lost`, as a logger that dropped them writes it.
+fn without_rows(log: &std::path::Path, lost: impl Fn(usize) -> bool) -> PathBuf {
+    rewritten(log, "dropped.csv", |r, line| {
+        (!lost(r)).then(|| line.to_string())
+    })
 }
 
 #[test]
@@ -500,16 +515,55 @@ fn a_log_whose_logger_lost_rows_is_read_as_the_whole_log() {
     // 1 kHz log: at the rise's speed limit (180 rad/s) the shaft turns 3.8 rad across each
     // gap, more than half a revolution, so the logged angle alone cannot say how far it
     // went, and a speed taken from it would jump by a revolution over the gap.
-    let (dir, log) = simulate(
-        "lost-rows",
-        "pressure-step",
-        None,
-        &["--log-rate", "1000", "--duration", "6"],
-    );
+    let lost = |log: &std::path::Path| without_rows(log, |r| r % 400 >= 380);
+    assert_read_as_the_whole_log("lost-rows", lost, 1.5, "with rows lost");
+}
+
+/// Simulates a 6 s pressure step logged at 1 kHz on the nominal rig, rewrites its log with
+/// `rewrite`, and asserts that both are explained alike within `bound` (`what` says how
+/// the rewritten one differs) and the rewritten one is named `none`.
+fn assert_read_as_the_whole_log(
+    name: &str,
+    rewrite: impl Fn(&std::path::Path) -> PathBuf,
+    bound: f64,
+    what: &str,
+) {
+    let one_khz = ["--log-rate", "1000", "--duration", "6"];
+    let (dir, log) = simulate(name, "pressure-step", None, &one_khz);
     let whole = diagnose_file(&log);
-    let dropped = diagnose_file(&without_rows(&log, |r| r % 400 >= 380));
-    assert_eq!(lead(&dropped), "none", "{dropped:#}");
+    let rewritten = diagnose_file(&rewrite(&log));
+    assert_eq!(lead(&rewritten), "none", "{rewritten:#}");
     let signals = ["p_pa", "iq_a", "speed_rad_s"];
-    assert_explained_alike(&whole, &dropped, &signals, 1.5, "with rows lost");
+    assert_explained_alike(&whole, &rewritten, &signals, bound, what);
     fs::remove_dir_all(dir).ok();
+}
+
+/// `log` with each row's time moved by up to ±`scatter` [s] (the first and last kept), as
+/// a PC that stamps telemetry rows on arrival writes it; the rows themselves unchanged.
+fn with_scattered_stamps(log: &std::path::Path, scatter: f64) -> PathBuf {
+    let text = fs::read_to_string(log).unwrap();
+    let rows = text.lines().filter(|l| !l.starts_with('#')).count() - 1;
+    let mut x = 0x2545_f491_4f6c_dd1du64;
+    rewritten(log, "stamped.csv", |r, line| {
+        if r == 0 || r + 1 == rows {
+            return Some(line.to_string());
+        }
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        let (first, rest) = line.split_once(',').unwrap();
+        let t: f64 = first.parse().unwrap();
+        Some(format!("{},{rest}", t + 2.0 * u * scatter))
+    })
+}
+
+#[test]
+fn rows_stamped_off_their_sampling_are_read_on_its_grid() {
+    // A drive samples on its own clock; the PC that logs its telemetry stamps each row as
+    // it arrives, ±0.2 ms about the millisecond it was taken. Read at those times the
+    // angle jumps by ω·δt (36 mrad at 180 rad/s) and the shaft's relations take that for
+    // motion; the logged angle turns smoothly only on the grid the rows were sampled on.
+    let stamped = |log: &std::path::Path| with_scattered_stamps(log, 0.2e-3);
+    assert_read_as_the_whole_log("scattered-stamps", stamped, 1.2, "with scattered stamps");
 }

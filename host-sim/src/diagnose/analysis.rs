@@ -233,6 +233,9 @@ pub fn analyse_reporting(
     rig.validate()?;
     let thinned = log.thinned(MIN_ANALYSED_INTERVAL_S);
     let log = thinned.as_ref().unwrap_or(log);
+    // Rows stamped off the even grid they were sampled on are read on it.
+    let retimed = super::retime::on_even_grid(log);
+    let log = retimed.as_ref().unwrap_or(log);
     // 1. Facts.
     let facts = LogFacts::of(log, rig);
     let motion = ShaftMotion::of(log, &facts, rig.motor.pole_pairs);

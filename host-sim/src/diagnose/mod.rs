@@ -67,6 +67,7 @@ mod release_tests;
 mod release_verdict;
 pub mod report;
 pub mod result;
+pub mod retime;
 pub mod secant;
 pub mod selection;
 pub mod signatures;
