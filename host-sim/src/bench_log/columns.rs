@@ -151,6 +151,21 @@ pub(super) fn keeps_row(last_kept_s: Option<f64>, t_s: f64, min_interval_s: f64)
     last_kept_s.is_none_or(|last| t_s - last >= min_interval_s)
 }
 
+/// Rows whose intervals tell whether a log is thinned at all. [1]
+pub const THINNING_PROBE_ROWS: usize = 65;
+
+/// Whether a log whose rows start at the times `t` [s] is sampled faster than
+/// `min_interval_s` [s], so that it is thinned: the median of its first
+/// [`THINNING_PROBE_ROWS`] rows' intervals lies below it. A log at or below that rate is
+/// read whole, so that stamps scattered about a 2 kHz grid do not lose the rows that came
+/// in early.
+pub(super) fn faster_than(t: &[f64], min_interval_s: f64) -> bool {
+    let head = &t[..t.len().min(THINNING_PROBE_ROWS)];
+    let mut d: Vec<f64> = head.windows(2).map(|w| w[1] - w[0]).collect();
+    d.sort_by(f64::total_cmp);
+    d.get(d.len() / 2).is_some_and(|m| *m < min_interval_s)
+}
+
 impl BenchLog {
     /// Number of samples (rows).
     pub fn len(&self) -> usize {
@@ -188,9 +203,13 @@ impl BenchLog {
         }
     }
 
-    /// The rows at least `min_interval_s` after the last row kept (the first row always),
-    /// as [`super::read_thinned`] keeps them; `None` when every row would be kept.
+    /// The rows at least `min_interval_s` after the last row kept (the first row always) of
+    /// a log sampled faster than that ([`faster_than`]), as [`super::read_thinned`] keeps
+    /// them; `None` when every row is kept.
     pub fn thinned(&self, min_interval_s: f64) -> Option<BenchLog> {
+        if !faster_than(&self.t_s, min_interval_s) {
+            return None;
+        }
         let mut keep = Vec::with_capacity(self.len());
         let mut last = None;
         for (k, &t) in self.t_s.iter().enumerate() {

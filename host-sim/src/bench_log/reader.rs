@@ -3,7 +3,7 @@
 //! the rows, each value checked as it is read ([`super::rules`]) within the bounds of
 //! [`super::limits`]; the first fault is reported with its file, line and column.
 
-use super::columns::{keeps_row, BenchLog, Signal, MIN_ROWS};
+use super::columns::{keeps_row, BenchLog, Signal, MIN_ROWS, THINNING_PROBE_ROWS};
 use super::error::{BenchLogError, Problem};
 use super::limits::{
     self, excerpt, line_too_long, LineLimited, MAX_METADATA_BYTES, MAX_METADATA_LINES,
@@ -18,10 +18,11 @@ pub fn read(path: &Path) -> Result<BenchLog, BenchLogError> {
     read_thinned(path, 0.0).map(|(log, _)| log)
 }
 
-/// Reads and checks a bench log, every row, but keeps only rows at least `min_interval_s`
-/// after the last row kept (the first row always): a log sampled faster than that is kept
-/// at about that interval, its rows unchanged, without holding the rest in memory. Returns
-/// the log and the number of rows the file holds.
+/// Reads and checks a bench log, every row; of a log sampled faster than `min_interval_s`
+/// (its first rows' median interval below it) keeps only rows at least that after the last
+/// row kept (the first row always): such a log is kept at about that interval, its rows
+/// unchanged, without holding the rest in memory. Returns the log and the number of rows
+/// the file holds.
 pub fn read_thinned(path: &Path, min_interval_s: f64) -> Result<(BenchLog, usize), BenchLogError> {
     let io_err = |source| BenchLogError::Read {
         file: path.to_path_buf(),
@@ -32,6 +33,17 @@ pub fn read_thinned(path: &Path, min_interval_s: f64) -> Result<(BenchLog, usize
     }
     let file = File::open(path).map_err(io_err)?;
     parse_thinned(BufReader::new(file), path, min_interval_s)
+}
+
+/// Thins `log` (every row read so far) as [`BenchLog::thinned`] does; whether it was.
+fn thin_whole(log: &mut BenchLog, min_interval_s: f64) -> bool {
+    match log.thinned(min_interval_s) {
+        Some(thinned) => {
+            *log = thinned;
+            true
+        }
+        None => false,
+    }
 }
 
 /// Parses a bench log from `input`; `path` names it in errors.
@@ -101,6 +113,8 @@ fn parse_thinned<R: Read>(
     let mut rows = 0usize;
     let mut previous_t: Option<f64> = None;
     let mut values = vec![0.0; known.len()];
+    // Whether rows are thinned: undecided until the first rows have been read.
+    let mut thin: Option<bool> = (min_interval_s <= 0.0).then_some(false);
     while reader
         .read_record(&mut record)
         .map_err(|e| csv_err(e, last_line + 1))?
@@ -119,11 +133,19 @@ fn parse_thinned<R: Read>(
         row.read_into(&names, &known, &mut values, &mut previous_t)?;
         rows += 1;
         let t = previous_t.unwrap_or(0.0);
-        if keeps_row(log.t_s.last().copied(), t, min_interval_s) {
+        if thin != Some(true) || keeps_row(log.t_s.last().copied(), t, min_interval_s) {
             for (&v, &(_, s)) in values.iter().zip(&known) {
                 log.column_mut(s).push(v);
             }
         }
+        // The first rows kept whole tell whether the log is thinned at all; if so, they are
+        // thinned as the rows after them are.
+        if thin.is_none() && rows == THINNING_PROBE_ROWS {
+            thin = Some(thin_whole(&mut log, min_interval_s));
+        }
+    }
+    if thin.is_none() {
+        thin_whole(&mut log, min_interval_s);
     }
     if rows < MIN_ROWS {
         return Err(err(

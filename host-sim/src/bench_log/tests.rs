@@ -304,6 +304,37 @@ fn drive_and_recorded_at_are_kept_and_read_alone_from_the_head() {
 }
 
 #[test]
+fn a_log_at_the_thinning_rate_with_scattered_stamps_is_read_whole() {
+    // 2 kHz rows (0.5 ms) stamped ±0.1 ms off their grid: a quarter of the intervals fall
+    // under 0.45 ms, but the log is no faster than the rows the diagnosis reads, so none is
+    // skipped.
+    let scatter = |i: usize| [0.0, 0.9e-4, -0.8e-4, 0.6e-4, -0.9e-4][i % 5];
+    let stamped = |i: usize| {
+        let t = if i == 0 {
+            0.0
+        } else {
+            i as f64 * 5e-4 + scatter(i)
+        };
+        format!("{t},5e6,{},6.0,1.5,0", 5e6 + i as f64)
+    };
+    let dir = std::env::temp_dir().join(format!("eha-thin-2k-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("stamped.csv");
+    std::fs::write(&path, log_text(1000, HEADER, stamped)).unwrap();
+    let whole = read(&path).unwrap();
+    let intervals = whole
+        .t_s
+        .windows(2)
+        .filter(|w| w[1] - w[0] < 0.45e-3)
+        .count();
+    assert!(intervals > 100, "{intervals} intervals under 0.45 ms");
+    let (log, rows) = read_thinned(&path, 0.45e-3).unwrap();
+    assert_eq!((rows, log.len()), (1000, 1000));
+    assert_eq!(whole.thinned(0.45e-3), None);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_thinned_read_keeps_rows_the_interval_apart_and_still_checks_every_row() {
     // 10 kHz rows (0.1 ms) read at 0.45 ms at least: every fifth row, as logged.
     let fast = |i: usize| format!("{},5e6,{},6.0,1.5,0", i as f64 * 1e-4, 5e6 + i as f64);
