@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{eha, s, scratch};
+use common::{edited, eha, rewritten, s, scratch};
 use serde_json::Value;
 use std::fs;
 use std::path::PathBuf;
@@ -473,35 +473,6 @@ fn a_log_without_the_angle_is_read_from_its_counted_speed() {
     );
 }
 
-/// `log` rewritten into `name` beside it, metadata and header kept, each data row `r`
-/// (from 0) replaced by what `row` makes of it (left out where it makes nothing).
-fn rewritten(
-    log: &std::path::Path,
-    name: &str,
-    mut row: impl FnMut(usize, &str) -> Option<String>,
-) -> PathBuf {
-    let text = fs::read_to_string(log).unwrap();
-    let mut out = String::new();
-    let mut header_seen = false;
-    let mut r = 0;
-    for line in text.lines() {
-        let kept = if line.starts_with('#') || !header_seen {
-            header_seen |= !line.starts_with('#');
-            Some(line.to_string())
-        } else {
-            r += 1;
-            row(r - 1, line)
-        };
-        if let Some(l) = kept {
-            out.push_str(&l);
-            out.push('\n');
-        }
-    }
-    let path = log.with_file_name(name);
-    fs::write(&path, out).unwrap();
-    path
-}
-
 /// `log` without the rows of `lost`, as a logger that dropped them writes it.
 fn without_rows(log: &std::path::Path, lost: impl Fn(usize) -> bool) -> PathBuf {
     rewritten(log, "dropped.csv", |r, line| {
@@ -544,17 +515,16 @@ fn with_scattered_stamps(log: &std::path::Path, scatter: f64) -> PathBuf {
     let text = fs::read_to_string(log).unwrap();
     let rows = text.lines().filter(|l| !l.starts_with('#')).count() - 1;
     let mut x = 0x2545_f491_4f6c_dd1du64;
-    rewritten(log, "stamped.csv", |r, line| {
+    edited(log, "stamped.csv", "t_s", |r, t| {
         if r == 0 || r + 1 == rows {
-            return Some(line.to_string());
+            return t.to_string();
         }
         x ^= x << 13;
         x ^= x >> 7;
         x ^= x << 17;
         let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-        let (first, rest) = line.split_once(',').unwrap();
-        let t: f64 = first.parse().unwrap();
-        Some(format!("{},{rest}", t + 2.0 * u * scatter))
+        let t: f64 = t.parse().unwrap();
+        format!("{}", t + 2.0 * u * scatter)
     })
 }
 

@@ -10,7 +10,7 @@ mod arguments;
 mod logs;
 mod outputs;
 
-use common::{eha, s};
+use common::{edited, eha, s};
 use host_sim::rig_file;
 use plant_model::Rig;
 use std::fs;
@@ -60,31 +60,4 @@ fn hold_log(dir: &Path) -> PathBuf {
 /// A pressure-hold log of `seconds` written to `dir/name`.
 fn hold_log_of(dir: &Path, name: &str, seconds: &str) -> PathBuf {
     common::simulated_hold(dir, name, seconds, &[])
-}
-
-/// `log` with `column` rewritten row by row (`row index, old text → new text`).
-fn edited(log: &Path, name: &str, column: &str, f: impl Fn(usize, &str) -> String) -> PathBuf {
-    let text = fs::read_to_string(log).unwrap();
-    let mut out = String::new();
-    let mut col = None;
-    let mut row = 0;
-    for line in text.lines() {
-        if line.starts_with('#') {
-            out.push_str(line);
-        } else if col.is_none() {
-            col = line.split(',').position(|c| c == column);
-            assert!(col.is_some(), "{column} in {line}");
-            out.push_str(line);
-        } else {
-            let mut fields: Vec<String> = line.split(',').map(str::to_string).collect();
-            let c = col.unwrap();
-            fields[c] = f(row, &fields[c]);
-            out.push_str(&fields.join(","));
-            row += 1;
-        }
-        out.push('\n');
-    }
-    let path = log.with_file_name(name);
-    fs::write(&path, out).unwrap();
-    path
 }
