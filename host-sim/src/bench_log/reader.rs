@@ -35,6 +35,9 @@ pub fn read_thinned(path: &Path, min_interval_s: f64) -> Result<(BenchLog, usize
     parse_thinned(BufReader::new(file), path, min_interval_s)
 }
 
+// A log too short to be probed is refused for its rows, so every log read was probed.
+const _: () = assert!(THINNING_PROBE_ROWS <= MIN_ROWS);
+
 /// Thins `log` (every row read so far) as [`BenchLog::thinned`] does; whether it was.
 fn thin_whole(log: &mut BenchLog, min_interval_s: f64) -> bool {
     match log.thinned(min_interval_s) {
@@ -143,9 +146,6 @@ fn parse_thinned<R: Read>(
         if thin.is_none() && rows == THINNING_PROBE_ROWS {
             thin = Some(thin_whole(&mut log, min_interval_s));
         }
-    }
-    if thin.is_none() {
-        thin_whole(&mut log, min_interval_s);
     }
     if rows < MIN_ROWS {
         return Err(err(
