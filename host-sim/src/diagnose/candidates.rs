@@ -4,7 +4,7 @@
 //! | effect | evidence | parameter's tolerance band |
 //! |---|---|---|
 //! | `extra_leakage` | hydraulic relation, leakage released upward | leakage ±20 % |
-//! | `entrained_air` | hydraulic relation, bulk modulus released | β ±5 % |
+//! | `entrained_air` | hydraulic relation (on a moving piston read for its position), bulk modulus released | β ±5 % |
 //! | `accumulator_precharge` | hydraulic relation, precharge released | p_0 ±5 % |
 //! | `pressure_sensor_lag` | hydraulic relation, lag released | 0–2.5 ms |
 //! | `shaft_friction` | mechanical relation, Coulomb torque released | 0–0.02 N·m |

@@ -74,6 +74,10 @@ pub struct LogFacts {
     /// the oil's stiffness A·β/V, 14 kPa per micrometre of a 71 cm² piston, so the
     /// transducer's noise would otherwise dominate the pressure it predicts. [m]
     pub x_smooth_m: Option<Vec<f64>>,
+    /// The logged port pressure smoothed as the position is, when the piston moves: the
+    /// position's volume balance multiplies it by the oil's compliance V/β/A, so its noise
+    /// would otherwise enter the predicted position and favour a stiffer oil. [Pa]
+    pub p_smooth_pa: Option<Vec<f64>>,
     /// Whether the piston moves but `x_m` is not logged: the oil the pump displaced swings
     /// over far more than the high side can store and leak
     /// ([`unseen_motion::unseen_piston_motion`]). The pressure's volume balance then lacks
@@ -129,6 +133,9 @@ impl LogFacts {
             log.x_m.as_deref().filter(|_| piston_moves).map(|x| {
                 savitzky_golay_smooth(x, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
             });
+        let p_smooth_pa = piston_moves.then(|| {
+            savitzky_golay_smooth(&log.p_pa, rows_spanning(POSITION_SMOOTHING_S, period_s, 1))
+        });
         let piston_unseen =
             log.x_m.is_none() && unseen_motion::unseen_piston_motion(log, p_low, rig);
         let split = segment_split(t, &theta_rad, period_s, rig);
@@ -175,6 +182,7 @@ impl LogFacts {
             p_low_estimate,
             piston_moves,
             x_smooth_m,
+            p_smooth_pa,
             piston_unseen,
             split,
             start,

@@ -1,7 +1,8 @@
 //! The hydraulic parity relation: the port pressure predicted from the logged shaft angle
 //! (the volume the pump displaced), piston position and low-side pressure, over short
 //! windows each re-started from the measured pressure (multiple shooting), so a small
-//! volume or displacement error cannot integrate into a drift.
+//! volume or displacement error cannot integrate into a drift. On a moving piston the same
+//! balance is read for the position instead ([`stroke`]).
 //!
 //! The high-pressure node (port A, its line and chamber A) with the pulsation absorber on
 //! it, eq. 9–11 and 22–26 of the paper as the plant model writes them:
@@ -49,6 +50,7 @@ use std::f64::consts::PI;
 use std::ops::Range;
 
 mod node;
+mod stroke;
 
 /// Longest integration substep. [s]
 pub const MAX_SUBSTEP_S: f64 = 0.5e-3;
@@ -172,6 +174,8 @@ pub struct HydraulicInputs<'a> {
     pub x_m: Option<&'a [f64]>,
     /// Measured pressure (window starts). [Pa]
     pub p_pa: &'a [f64],
+    /// Measured pressure smoothed, when the piston moves ([`LogFacts::p_smooth_pa`]). [Pa]
+    pub p_smooth_pa: Option<&'a [f64]>,
     /// Rows a window's start is fitted to ([`START_S`] at the log's sampling).
     pub start_rows: usize,
     /// The fill level the port's check valve holds it above, as the transducer reads it. [Pa]
@@ -192,6 +196,7 @@ impl<'a> HydraulicInputs<'a> {
             },
             x_m: facts.x_smooth_m.as_deref(),
             p_pa: &log.p_pa,
+            p_smooth_pa: facts.p_smooth_pa.as_deref(),
             start_rows: rows_spanning(START_S, facts.period_s, 2),
             // The check valve opens only where the port is the suction side: a moving
             // payload's, or a blocked cylinder's whose pump reverses into a low side it
@@ -434,6 +439,7 @@ mod tests {
             case_pa: LowSide::Level(0.5e6),
             x_m: None,
             p_pa: &p,
+            p_smooth_pa: None,
             start_rows: 10,
             fill_pa: 0.0,
         };

@@ -202,6 +202,36 @@ pub fn hydraulic_residuals(
     out
 }
 
+/// The hydraulic relation's residuals on a moving piston (measured − predicted position
+/// over its noise, [`Hydraulics::predict_position_window`]) over `windows`, each window's
+/// first row left out.
+pub fn position_residuals(
+    log: &BenchLog,
+    facts: &LogFacts,
+    rig: &Rig,
+    params: HydraulicParams,
+    x_logged: &[f64],
+    windows: &[Range<usize>],
+) -> Vec<f64> {
+    let sigma = facts
+        .noise(Signal::PistonPosition)
+        .filter(|s| *s > 0.0)
+        .unwrap_or(1e-6);
+    let model = Hydraulics::new(params, rig);
+    let inputs = HydraulicInputs::of(log, facts);
+    windows
+        .par_iter()
+        .map(|w| {
+            let mut pred = vec![0.0; w.len()];
+            model.predict_position_window(&inputs, x_logged, w.clone(), &mut pred);
+            (w.start + 1..w.end)
+                .map(|k| huber((x_logged[k] - pred[k - w.start]) / sigma))
+                .collect::<Vec<f64>>()
+        })
+        .flatten()
+        .collect()
+}
+
 /// The hydraulic relation of a log.
 pub struct HydraulicRelation<'a> {
     /// The log.
@@ -220,6 +250,11 @@ const DISTINCT_START_RATIO: f64 = 1.03;
 const PRECHARGE_BASINS: usize = 2;
 
 impl HydraulicRelation<'_> {
+    /// The logged piston position, when the piston moves: the balance is then read for it.
+    pub fn moving_piston(&self) -> Option<&[f64]> {
+        self.log.x_m.as_deref().filter(|_| self.facts.piston_moves)
+    }
+
     /// The released precharge's starting grid around the rig file's `p0`: 0.3–3 times it,
     /// and a point between each two neighbouring start pressures of the identification's
     /// shooting windows. A window starting at p_w starts its absorber empty when the
@@ -260,8 +295,24 @@ impl Relation for HydraulicRelation<'_> {
     fn facts(&self) -> &LogFacts {
         self.facts
     }
+    /// On a moving piston the transducer's gain, zero and lag held at the rig file's: the
+    /// position's balance reads the pressure only through the oil's compliance and the
+    /// leakage, so they would drift to their bands' edges there and bend the pressure the
+    /// calibrated model predicts.
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
-        hydraulic_specs(self.rig, release, self.facts.low_side_apart)
+        let mut specs = hydraulic_specs(self.rig, release, self.facts.low_side_apart);
+        if self.moving_piston().is_some() {
+            let n = HydraulicParams::nominal(self.rig);
+            for (i, value) in [
+                (hyd::GAIN, 1.0),
+                (hyd::OFFSET, n.sensor_offset_pa),
+                (hyd::LAG, n.sensor_lag_s),
+            ] {
+                let s = specs[i].clone().starting_at(value);
+                specs[i] = s.with_band(value, value);
+            }
+        }
+        specs
     }
 
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
@@ -293,7 +344,19 @@ impl Relation for HydraulicRelation<'_> {
         }
     }
 
+    /// On a moving piston with its position logged, the position's residuals
+    /// ([`position_residuals`]); elsewhere the pressure's.
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
+        if let Some(x) = self.moving_piston() {
+            return position_residuals(
+                self.log,
+                self.facts,
+                self.rig,
+                hydraulic_params(self.rig, values),
+                x,
+                rows,
+            );
+        }
         hydraulic_residuals(
             self.log,
             self.facts,

@@ -94,6 +94,9 @@ impl<'a> Relations<'a> {
                 Precision::Learning => Effort::THOROUGH,
             },
             screening: match precision {
+                // A moving piston's volume balance is read for the position, a sum of
+                // rows without an integration to screen (`hydraulic::stroke`).
+                _ if facts.piston_moves => Effort::THOROUGH,
                 Precision::Diagnosis => Effort::SCREENING,
                 Precision::Learning => Effort::THOROUGH,
             },
