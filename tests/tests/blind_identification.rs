@@ -353,6 +353,37 @@ fn the_diagnosis_finds_every_hidden_effect() {
     );
 }
 
+/// Coverage seeds that hide entrained air on a stroke of the free payload, with a Coulomb
+/// cylinder friction (40) or a current offset (39) beside it: the oil's compliance shows
+/// in the piston's position where the port pressure moves (the reversal, the friction's
+/// stick-slip), which the volume balance read for the position measures. Seed 36, air
+/// alone on a stroke, is left out: its only reversal falls in the validation segment,
+/// and the identification segment's port pressure never moves.
+const AIR_ON_A_STROKE_SEEDS: [u64; 2] = [39, 40];
+
+/// Entrained air on a stroke named, with its bulk modulus, beside the other effect.
+#[test]
+fn air_on_a_stroke_is_read_from_the_position() {
+    for seed in AIR_ON_A_STROKE_SEEDS {
+        let t = outline(seed);
+        assert_eq!(t.test, "stroke", "seed {seed}");
+        assert!(
+            t.effects.iter().any(|e| e.name == "entrained_air"),
+            "seed {seed} hides no air"
+        );
+    }
+    let failed = run_and_judge(&AIR_ON_A_STROKE_SEEDS);
+    assert!(
+        failed.is_empty(),
+        "{}",
+        failed
+            .iter()
+            .map(|(_, a)| a.as_str())
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+}
+
 /// The suite's seeds cover, without simulating them: every effect on every test where it
 /// can act at all (the cylinder's friction on strokes only, the absorber's precharge on
 /// pressure tests only) unless the coverage table records it as never showing there;
