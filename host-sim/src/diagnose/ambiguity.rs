@@ -13,8 +13,10 @@
 //! - **Entrained air against the line volume.** With the cylinder blocked the pressure
 //!   reads only the oil's compliance V_h/β (eq. 11): a bulk modulus β̂ below the rig's is
 //!   the same log as a high-side volume V_h·β/β̂ at the listed β. The rig's line volume is
-//!   not a catalogue effect, so the evidence says it; a stroke, whose piston adds the
-//!   absolute volume A·x, separates them.
+//!   not a catalogue effect, so the evidence says it. On a stroke the piston's position
+//!   reads the compliance (`hydraulic/stroke.rs`), and its travel A·x, a small part of the
+//!   chamber, separates the two only in part: the evidence says the bulk modulus reads low
+//!   by what a longer line adds.
 //! - **Coulomb against viscous friction at one speed.** T_c·sign(ω) and B·ω are the same
 //!   column when |ω| takes one value: a shaft friction read from steady windows at one
 //!   speed (their speeds within [`ONE_SPEED_SPREAD`] of their mean) is as well a viscous
@@ -147,6 +149,12 @@ pub(super) fn mark(
                     ));
                 }
             }
+            "entrained_air" => tested[i].evidence.push_str(
+                "; read from the piston's position, which lags the pump by the oil's \
+                 compressed volume (V/β)·Δp/A where the port pressure moves: a longer line \
+                 to chamber A (a larger V) takes part of that compliance, so the bulk \
+                 modulus reads low by as much as the line adds to the chamber",
+            ),
             "shaft_friction" => {
                 if let Some(speed) = one_speed(facts) {
                     tested[i].evidence.push_str(&format!(
