@@ -74,9 +74,11 @@ pub struct LogFacts {
     /// the oil's stiffness A·β/V, 14 kPa per micrometre of a 71 cm² piston, so the
     /// transducer's noise would otherwise dominate the pressure it predicts. [m]
     pub x_smooth_m: Option<Vec<f64>>,
-    /// The logged port pressure smoothed as the position is, when the piston moves: the
-    /// position's volume balance multiplies it by the oil's compliance V/β/A, so its noise
-    /// would otherwise enter the predicted position and favour a stiffer oil. [Pa]
+    /// The logged port pressure smoothed as the position is ([`Self::x_smooth_m`]), when
+    /// the piston moves: the position's volume balance multiplies it by the oil's
+    /// compliance V/β/A, so its noise would otherwise enter the predicted position and
+    /// favour a stiffer oil. The balance is read between the two smoothed signals, the
+    /// same filter on both sides of a linear relation. [Pa]
     pub p_smooth_pa: Option<Vec<f64>>,
     /// Whether the piston moves but `x_m` is not logged: the oil the pump displaced swings
     /// over far more than the high side can store and leak

@@ -202,9 +202,11 @@ pub fn hydraulic_residuals(
     out
 }
 
-/// The hydraulic relation's residuals on a moving piston (measured − predicted position
-/// over its noise, [`Hydraulics::predict_position_window`]) over `windows`, each window's
-/// first row left out.
+/// The hydraulic relation's residuals on a moving piston (read − predicted position over
+/// the logged position's noise, [`Hydraulics::predict_position_window`]; `x_logged`
+/// smoothed, so the residuals' own noise lies below that unit and the relation's
+/// likelihood ratios are the conservative side) over `windows`, each window's first row
+/// left out.
 pub fn position_residuals(
     log: &BenchLog,
     facts: &LogFacts,
@@ -250,9 +252,15 @@ const DISTINCT_START_RATIO: f64 = 1.03;
 const PRECHARGE_BASINS: usize = 2;
 
 impl HydraulicRelation<'_> {
-    /// The logged piston position, when the piston moves: the balance is then read for it.
+    /// The piston position the balance is read for, when the piston moves: the logged one
+    /// smoothed as the pressure is ([`LogFacts::p_smooth_pa`]). Against the raw position
+    /// the smoothed pressure's rounded corners (a cylinder friction's stick-slip turns it
+    /// every few tens of milliseconds) read as a softer oil.
     pub fn moving_piston(&self) -> Option<&[f64]> {
-        self.log.x_m.as_deref().filter(|_| self.facts.piston_moves)
+        self.facts
+            .x_smooth_m
+            .as_deref()
+            .filter(|_| self.facts.piston_moves)
     }
 
     /// The released precharge's starting grid around the rig file's `p0`: 0.3–3 times it,

@@ -6,8 +6,7 @@
 //!   A·dx = D/2π·s(θ)·dθ − [G_pp·(p − p_low) + (G − G_pp)·(p − p_c)]·dt − dv_abs − (V_h + A·x)/β·dp
 //! ```
 //!
-//! with p the true port pressure the transducer's reading gives ((p_meas − o)/g, smoothed
-//! as the position is: [`crate::diagnose::facts::LogFacts::p_smooth_pa`]) and v_abs
+//! with p the true port pressure the transducer's reading gives ((p_meas − o)/g) and v_abs
 //! the absorber's oil at it (the gas law quasi-static: the inlet's time constant is tens of
 //! microseconds). On a moving piston the pressure's own balance multiplies the position
 //! transducer's noise by the oil's stiffness (β/V·A·σ_x, tens of kPa for a micrometre);
@@ -15,6 +14,12 @@
 //! (V/β/A·σ_p, below a nanometre) and the position carries its own noise alone. The oil's
 //! compliance then shows in the position wherever the port pressure moves: the piston
 //! lags the pump by (V/β)·Δp/A when the port is loaded at a reversal or an acceleration.
+//!
+//! Position and pressure are both read smoothed by the same filter
+//! ([`crate::diagnose::facts::LogFacts::p_smooth_pa`]): the relation is linear in them, so
+//! it holds between the filtered signals as between the raw ones, while the pressure's
+//! noise, multiplied by the compliance, no longer favours a stiffer oil, and the filter's
+//! rounding of a sharp pressure turn (a friction's stick-slip) is the position's too.
 //!
 //! Each window is summed from its first row, and the start position is the least-squares
 //! one (the mean difference between the logged position and the window's sum), so a noisy
@@ -27,9 +32,9 @@ use std::f64::consts::PI;
 use std::ops::Range;
 
 impl Hydraulics {
-    /// Predicts the logged piston position `x_logged` over the window `rows` into `out`,
-    /// row `rows.start + i` at index i, from the pump's swept volume and the logged port
-    /// pressure.
+    /// Predicts the piston position `x_logged` (as the relation reads it: smoothed as the
+    /// pressure is) over the window `rows` into `out`, row `rows.start + i` at index i, from
+    /// the pump's swept volume and the port pressure.
     pub fn predict_position_window(
         &self,
         x: &HydraulicInputs<'_>,
