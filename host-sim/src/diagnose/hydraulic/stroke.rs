@@ -61,7 +61,8 @@ impl Hydraulics {
         let mut sum = 0.0;
         let (mut p, mut v_abs) = (p_true(rows.start), 0.0);
         v_abs += absorbed(p);
-        for k in rows.start..rows.end.saturating_sub(1) {
+        let steps = rows.start..rows.end.saturating_sub(1).max(rows.start);
+        for (k, x_here) in steps.clone().zip(&x_logged[steps]) {
             let next = k + 1;
             let dt = x.t_s[next] - x.t_s[k];
             let dtheta = x.theta_rad[next] - x.theta_rad[k];
@@ -72,7 +73,6 @@ impl Hydraulics {
             };
             let p_next = p_true(next);
             let v_next = absorbed(p_next);
-            let x_here = x.x_m.map_or(x_logged[k], |xm| xm[k]);
             let compliance =
                 (hp.high_side_volume_m3 + area * x_here).max(1e-9) / hp.bulk_modulus_pa;
             let volume = per_rad * factor * dtheta
