@@ -381,17 +381,7 @@ fn messages_give_the_true_reason() {
         assert!(!err.contains("finite"), "{err}");
     }
     // Left out, the order is the rig's LCM(9 slots, 8 poles) = 72, and the log says 72.
-    let o = eha(&[
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
-        "0.1",
-        "--out",
-        s(&out),
-        "--effects",
-        "cogging_torque",
-    ]);
+    let o = eha(&short_hold(&out, &["--effects", "cogging_torque"]));
     assert_eq!(status(&o), 0, "{}", stderr(&o));
     let text = fs::read_to_string(&out).unwrap();
     let effects = text.lines().find(|l| l.starts_with("# effects:")).unwrap();

@@ -39,6 +39,22 @@ fn entries(dir: &Path) -> Vec<String> {
     v
 }
 
+/// The arguments of `eha simulate`'s 0.1 s pressure holding with its log at `sim`, followed
+/// by `more`.
+fn short_hold<'a>(sim: &'a Path, more: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "simulate",
+        "--scenario",
+        "pressure-hold",
+        "--duration",
+        "0.1",
+        "--out",
+        s(sim),
+    ];
+    args.extend_from_slice(more);
+    args
+}
+
 /// Runs `args`, expecting exit 2 with every one of `named` in the message, no panic.
 fn refused(args: &[&str], named: &[&str]) -> String {
     let o = eha(args);

@@ -239,7 +239,7 @@ fn a_full_disk_on_the_last_output_leaves_nothing() {
     let json = dir.join("s.json");
     // The bench log was written before; the run's log and its summary fail together.
     fs::write(&sim, "an earlier run").unwrap();
-    let o = eha_with(&full("staged:2"), &short_hold(&sim, &json));
+    let o = eha_with(&full("staged:2"), &short_hold(&sim, &["--json", s(&json)]));
     let err = stderr(&o);
     assert_eq!(status(&o), 1, "{err}");
     assert!(
@@ -334,7 +334,7 @@ fn an_interrupt_in_the_write_phase_leaves_every_output_or_none() {
     let run = |point: &str| {
         eha_with(
             &[("EHA_TEST_INTERRUPT_AT", point)],
-            &short_hold(&sim, &json),
+            &short_hold(&sim, &["--json", s(&json)]),
         )
     };
     // Earlier outputs stand for what must survive an interrupted run whole.
@@ -449,20 +449,4 @@ fn the_demo_folder_is_written_whole_or_not_at_all() {
         assert_eq!(contents(&out), was, "{env:?}: the folder as it was");
         assert_eq!(entries(&dir), ["d"], "{env:?}: no staging folder");
     }
-}
-
-/// The arguments of `eha simulate`'s 0.1 s pressure holding with its log at `sim` and its
-/// summary at `json`.
-fn short_hold<'a>(sim: &'a Path, json: &'a Path) -> [&'a str; 9] {
-    [
-        "simulate",
-        "--scenario",
-        "pressure-hold",
-        "--duration",
-        "0.1",
-        "--out",
-        s(sim),
-        "--json",
-        s(json),
-    ]
 }
