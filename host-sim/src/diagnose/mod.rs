@@ -79,6 +79,7 @@ pub mod stick;
 mod test_noise;
 pub mod uneven_derivative;
 pub mod unseen_motion;
+pub mod unseen_precharge;
 pub mod validation_spread;
 
 pub use diagnosis::{Cause, Diagnosis, Extended, Fit, Gain};

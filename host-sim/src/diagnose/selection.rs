@@ -25,11 +25,13 @@ use super::ambiguity::mark;
 use super::calibration::{
     calibrate, polished, test_release, Calibration, Freed, Relation, Release,
 };
-use super::candidates::{reread, Extension, Tested};
+use super::candidates::{reread, short, Extension, Tested};
 use super::decision::{apply_vetoes, threshold, why_not};
 use super::displacement::{read_volumes_at, Displacement};
+use super::hydraulic_relation::hyd;
 use super::relations::Relations;
 use super::release_verdict::from_release;
+use super::unseen_precharge::least_unseen_precharge;
 use plant_model::Rig;
 use rayon::prelude::*;
 
@@ -192,7 +194,9 @@ fn forward_hydraulic(
 }
 
 /// The hydraulic relation's values with the `named` releases freed, from their fit `c`:
-/// driven on to the report's effort, and each named entry of `tested` read again there.
+/// driven on to the report's effort, and each named entry of `tested` read again there; a
+/// named precharge the log bounds from below only read at that bound
+/// ([`least_unseen_precharge`]).
 fn reported(
     rel: &Relations<'_>,
     tested: &mut [Tested],
@@ -200,16 +204,41 @@ fn reported(
     c: Calibration,
     rig: &Rig,
 ) -> Vec<f64> {
-    let Some(effort) = rel.reported_effort() else {
-        return c.fitted.values;
+    let mut c = match rel.reported_effort() {
+        None => c,
+        Some(effort) => {
+            let freed = Freed {
+                relation: &rel.hydraulic,
+                freed: named.iter().map(|&i| tested[i].release).collect(),
+            };
+            let c = polished(&freed, &rel.h_id, &c, effort);
+            for &i in named {
+                reread(&mut tested[i], &c, rig);
+            }
+            c
+        }
     };
-    let freed = Freed {
-        relation: &rel.hydraulic,
-        freed: named.iter().map(|&i| tested[i].release).collect(),
-    };
-    let c = polished(&freed, &rel.h_id, &c, effort);
-    for &i in named {
-        reread(&mut tested[i], &c, rig);
+    let precharge = named
+        .iter()
+        .copied()
+        .find(|&i| tested[i].release == Release::Precharge);
+    if let Some(i) = precharge {
+        let nominal = rel.hydraulic.specs(Release::Nothing)[hyd::PRECHARGE].nominal;
+        let log = rel.hydraulic.log;
+        let v = &c.fitted.values;
+        if let Some(p) =
+            least_unseen_precharge(&rel.hydraulic, &rel.h_id, v, c.scale, &log.p_pa, nominal)
+        {
+            let fitted = v[hyd::PRECHARGE];
+            c.fitted.values[hyd::PRECHARGE] = p;
+            reread(&mut tested[i], &c, rig);
+            tested[i].evidence.push_str(&format!(
+                "; the identification's pressure never reaches it, so the log bounds it \
+                 from below only: read at the least precharge that fits as well as the \
+                 fit's {} Pa",
+                short(fitted)
+            ));
+        }
     }
     c.fitted.values
 }
