@@ -372,7 +372,18 @@ fn air_on_a_stroke_is_read_from_the_position() {
             "seed {seed} hides no air"
         );
     }
-    let failed = run_and_judge(&AIR_ON_A_STROKE_SEEDS);
+    all_right(&AIR_ON_A_STROKE_SEEDS);
+}
+
+/// Freely drawn pressure tests whose absorber's precharge (4.23–4.40 MPa) lies above every
+/// pressure of their identification segment: the absorber never takes oil there, every
+/// higher precharge fits as well, and the fit stops on that flat stretch (6.0 MPa, 36–42 %
+/// off). The log bounds the precharge from below only, and it is read at that bound.
+const PRECHARGE_ABOVE_THE_TEST_SEEDS: [u64; 3] = [4_302_112, 4_305_405, 4_318_304];
+
+/// Every one of `seeds` judged right, or the judge's account of each that is not.
+fn all_right(seeds: &[u64]) {
+    let failed = run_and_judge(seeds);
     assert!(
         failed.is_empty(),
         "{}",
@@ -382,6 +393,20 @@ fn air_on_a_stroke_is_read_from_the_position() {
             .collect::<Vec<_>>()
             .join("\n")
     );
+}
+
+/// A precharge above the test's pressures named, and read within the judge's standard.
+#[test]
+fn a_precharge_above_the_test_is_read_at_the_bound_the_log_sets() {
+    for seed in PRECHARGE_ABOVE_THE_TEST_SEEDS {
+        let t = outline(seed);
+        assert!(
+            t.effects.len() == 1 && t.effects[0].name == "accumulator_precharge",
+            "seed {seed} hides {:?}",
+            t.effects.iter().map(|e| e.name).collect::<Vec<_>>()
+        );
+    }
+    all_right(&PRECHARGE_ABOVE_THE_TEST_SEEDS);
 }
 
 /// The suite's seeds cover, without simulating them: every effect on every test where it
