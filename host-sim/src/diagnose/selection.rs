@@ -218,29 +218,42 @@ fn reported(
             c
         }
     };
-    let precharge = named
+    read_unseen_precharge(rel, tested, named, &mut c, rig);
+    c.fitted.values
+}
+
+/// A named precharge that `c` fits above every pressure of the identification segment,
+/// read at the least precharge the log cannot tell from the fit ([`least_unseen_precharge`])
+/// in `c` and in its entry of `tested`, whose evidence says so.
+fn read_unseen_precharge(
+    rel: &Relations<'_>,
+    tested: &mut [Tested],
+    named: &[usize],
+    c: &mut Calibration,
+    rig: &Rig,
+) {
+    let Some(i) = named
         .iter()
         .copied()
-        .find(|&i| tested[i].release == Release::Precharge);
-    if let Some(i) = precharge {
-        let nominal = rel.hydraulic.specs(Release::Nothing)[hyd::PRECHARGE].nominal;
-        let log = rel.hydraulic.log;
-        let v = &c.fitted.values;
-        if let Some(p) =
-            least_unseen_precharge(&rel.hydraulic, &rel.h_id, v, c.scale, &log.p_pa, nominal)
-        {
-            let fitted = v[hyd::PRECHARGE];
-            c.fitted.values[hyd::PRECHARGE] = p;
-            reread(&mut tested[i], &c, rig);
-            tested[i].evidence.push_str(&format!(
-                "; the identification's pressure never reaches it, so the log bounds it \
-                 from below only: read at the least precharge that fits as well as the \
-                 fit's {} Pa",
-                short(fitted)
-            ));
-        }
-    }
-    c.fitted.values
+        .find(|&i| tested[i].release == Release::Precharge)
+    else {
+        return;
+    };
+    let nominal = rel.hydraulic.specs(Release::Nothing)[hyd::PRECHARGE].nominal;
+    let p_pa = &rel.hydraulic.log.p_pa;
+    let v = &c.fitted.values;
+    let Some(p) = least_unseen_precharge(&rel.hydraulic, &rel.h_id, v, c.scale, p_pa, nominal)
+    else {
+        return;
+    };
+    let fitted = v[hyd::PRECHARGE];
+    c.fitted.values[hyd::PRECHARGE] = p;
+    reread(&mut tested[i], c, rig);
+    tested[i].evidence.push_str(&format!(
+        "; the identification's pressure never reaches it, so the log bounds it from below \
+         only: read at the least precharge that fits as well as the fit's {} Pa",
+        short(fitted)
+    ));
 }
 
 /// `release` tested on `relation` (the model extended by its freed effects) against
