@@ -59,6 +59,10 @@ pub struct LogFacts {
     /// unloaded port sits there), or the rig's fill pressure less the check valve's
     /// cracking when the low side is not logged. [Pa]
     pub fill_pa: f64,
+    /// The level the port holds on its check valve row by row where a blocked cylinder's
+    /// pump reverses into its pressurised low side ([`low_side::sucked_port_track`]);
+    /// `None` elsewhere, where [`LogFacts::fill_pa`] holds for every row. [Pa]
+    pub fill_track_pa: Option<Vec<f64>>,
     /// Whether the piston moves (`x_m` logged and travelling).
     pub piston_moves: bool,
     /// Whether the low side (logged or estimated) departs from the fill
@@ -170,6 +174,10 @@ impl LogFacts {
             }
             None => rig.fill.pressure_pa - rig.fill.check_cracking_pa,
         };
+        let fill_track_pa = (low.is_some() && low_side_apart && !piston_moves).then(|| {
+            let w_noise = noise_of(&noise_rms, Signal::Speed).unwrap_or(0.0);
+            low_side::sucked_port_track(log, start, period_s, p_noise, w_noise, fill_pa)
+        });
         let (steady, lines_split) =
             line_split::divided_windows(t, &theta_rad, period_s, rig, split, start);
         LogFacts {
@@ -180,6 +188,7 @@ impl LogFacts {
             angle,
             fill_low_pa,
             fill_pa,
+            fill_track_pa,
             low_side_apart,
             p_low_estimate,
             piston_moves,

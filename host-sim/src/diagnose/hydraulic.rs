@@ -180,6 +180,9 @@ pub struct HydraulicInputs<'a> {
     pub start_rows: usize,
     /// The fill level the port's check valve holds it above, as the transducer reads it. [Pa]
     pub fill_pa: f64,
+    /// The fill level row by row where it moves ([`LogFacts::fill_track_pa`]), in place of
+    /// `fill_pa`. [Pa]
+    pub fill_track_pa: Option<&'a [f64]>,
 }
 
 impl<'a> HydraulicInputs<'a> {
@@ -207,6 +210,7 @@ impl<'a> HydraulicInputs<'a> {
             } else {
                 f64::NEG_INFINITY
             },
+            fill_track_pa: facts.fill_track_pa.as_deref(),
         }
     }
 }
@@ -354,7 +358,10 @@ impl Hydraulics {
         let per_rad = hp.displacement_m3_per_rev / (2.0 * PI);
         // The check valve from the fill holds the port at the fill level: the transducer's
         // reading of it in true pressure.
-        let floor = (x.fill_pa - hp.sensor_offset_pa) / gain.max(1e-6);
+        let floor_at = |k: usize| {
+            let fill = x.fill_track_pa.map_or(x.fill_pa, |f| f[k]);
+            (fill - hp.sensor_offset_pa) / gain.max(1e-6)
+        };
         // Each log interval's substeps and the transducer's factors over them.
         let mut intervals = Intervals::new(hp.sensor_lag_s, substeps);
         for k in rows.start..rows.end.saturating_sub(1) {
@@ -378,6 +385,7 @@ impl Hydraulics {
             };
             let uniform = !ripple && dx == 0.0;
             let row = (q_at(1.0), c_at(0.0));
+            let floor = floor_at(k);
             for j in 0..steps {
                 let (q_in, c_oil) = if uniform {
                     row
@@ -442,6 +450,7 @@ mod tests {
             p_smooth_pa: None,
             start_rows: 10,
             fill_pa: 0.0,
+            fill_track_pa: None,
         };
         let mut out = vec![0.0; n];
         Hydraulics::new(hp.clone(), &Rig::nominal()).simulate_window(

@@ -293,6 +293,63 @@ pub fn sucked_port_level(log: &BenchLog, start: usize, period_s: f64, noise_pa: 
     held[held.len() / 10]
 }
 
+/// Length of the blocks over which [`sucked_port_track`] reads the port's level. [s]
+pub const SUCKED_BLOCK_S: f64 = 0.25;
+
+/// Share of a block's rows that must sit on the check valve for its own level to be read
+/// there. [1]
+pub const SUCKED_BLOCK_SHARE: f64 = 0.4;
+
+/// Farthest a block's own level may lie above the log's ([`sucked_port_level`]): the fill
+/// accumulator's sinking as it gives oil and the check valve's drop at the pump's suction
+/// flow; a port held higher than that by the low side's leakage is not on its valve. [Pa]
+pub const SUCKED_SPREAD_PA: f64 = 0.1e6;
+
+/// The level the port holds on its check valve row by row: `level` (the log's,
+/// [`sucked_port_level`]) except over the blocks of [`SUCKED_BLOCK_S`] from `start` whose
+/// rows sit on the valve for [`SUCKED_BLOCK_SHARE`] of the block, which read their own:
+/// the lowest tenth of the block's readings where the pump turns backwards (faster than
+/// four of the speed's noise RMS `speed_noise`: a shaft at rest reads backwards half the
+/// time) within [`SUCKED_BAND_PA`] and four of the port's noise RMS `noise_pa` of the
+/// block's lowest such reading, if within [`SUCKED_SPREAD_PA`] above `level`. The fill sinks as it gives oil and the
+/// valve's drop grows with the suction flow, so one level for the log lies below the
+/// port wherever the suction is slower or the fill fuller. [Pa]
+pub fn sucked_port_track(
+    log: &BenchLog,
+    start: usize,
+    period_s: f64,
+    noise_pa: f64,
+    speed_noise: f64,
+    level: f64,
+) -> Vec<f64> {
+    let n = log.len();
+    let mut track = vec![level; n];
+    let block = ((SUCKED_BLOCK_S / period_s).round() as usize).max(2);
+    let band = SUCKED_BAND_PA + 4.0 * noise_pa;
+    let mut b0 = start.min(n);
+    while b0 < n {
+        let b1 = (b0 + block).min(n);
+        let sucking = || {
+            log.p_pa[b0..b1]
+                .iter()
+                .zip(&log.speed_rad_s[b0..b1])
+                .filter(|(_, w)| **w < -4.0 * speed_noise)
+                .map(|(p, _)| *p)
+        };
+        let lowest = sucking().fold(f64::INFINITY, f64::min);
+        let mut held: Vec<f64> = sucking().filter(|p| *p < lowest + band).collect();
+        if held.len() as f64 >= SUCKED_BLOCK_SHARE * (b1 - b0) as f64 {
+            held.sort_by(f64::total_cmp);
+            let own = held[held.len() / 10];
+            if own > level && own <= level + SUCKED_SPREAD_PA {
+                track[b0..b1].fill(own);
+            }
+        }
+        b0 = b1;
+    }
+    track
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -437,5 +494,33 @@ mod tests {
         };
         assert_eq!(level(500), 0.516e6);
         assert_eq!(level(50), 0.510e6);
+    }
+
+    #[test]
+    fn the_sucked_port_is_floored_at_the_level_each_block_holds() {
+        // 1 kHz: a second sucked slowly with the port on its valve at 0.705 MPa (a full
+        // fill, a small drop), a second sucked fast at 0.663 MPa (the fill sunk, a larger
+        // drop), half a second held at 0.9 MPa by the low side's leakage with the pump
+        // backwards, then forwards at 2 MPa. The log's level is 0.663 MPa; the slow second's
+        // blocks read 0.705 MPa, the held half second lies 237 kPa above the log's level,
+        // beyond the spread a valve gives, and keeps it, as do the forward rows.
+        let n = 3000;
+        let speed: Vec<f64> = (0..n)
+            .map(|k| match k {
+                0..=999 => -20.0,
+                1000..=1999 => -90.0,
+                2000..=2499 => -2.0,
+                _ => 30.0,
+            })
+            .collect();
+        let mut log = log_of(2e6, &speed, vec![0.0; n]);
+        log.p_pa[..1000].fill(0.705e6);
+        log.p_pa[1000..2000].fill(0.663e6);
+        log.p_pa[2000..2500].fill(0.9e6);
+        let level = sucked_port_level(&log, 0, 1e-3, 0.0);
+        assert_eq!(level, 0.663e6);
+        let track = sucked_port_track(&log, 0, 1e-3, 0.0, 0.1, level);
+        assert!(track[..1000].iter().all(|p| *p == 0.705e6));
+        assert!(track[1000..].iter().all(|p| *p == 0.663e6));
     }
 }

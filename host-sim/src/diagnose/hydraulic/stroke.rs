@@ -117,6 +117,7 @@ mod tests {
             p_smooth_pa: None,
             start_rows: 10,
             fill_pa: low,
+            fill_track_pa: None,
         };
         let mut out = vec![0.0; n];
         Hydraulics::new(hp, &Rig::nominal()).predict_position_window(&inputs, x, 0..n, &mut out);
