@@ -302,7 +302,9 @@ pub const SUCKED_BLOCK_SHARE: f64 = 0.4;
 
 /// Farthest a block's own level may lie above the log's ([`sucked_port_level`]): the fill
 /// accumulator's sinking as it gives oil and the check valve's drop at the pump's suction
-/// flow; a port held higher than that by the low side's leakage is not on its valve. [Pa]
+/// flow (the nominal valve's 1e-9 m³/(s·Pa) drops 24 kPa at 100 rad/s of suction; a drawn
+/// fill sank 40 kPa over a log), twice over; a port held higher than that by the low
+/// side's leakage is not on its valve. [Pa]
 pub const SUCKED_SPREAD_PA: f64 = 0.1e6;
 
 /// The level the port holds on its check valve row by row: `level` (the log's,
@@ -311,9 +313,9 @@ pub const SUCKED_SPREAD_PA: f64 = 0.1e6;
 /// the lowest tenth of the block's readings where the pump turns backwards (faster than
 /// four of the speed's noise RMS `speed_noise`: a shaft at rest reads backwards half the
 /// time) within [`SUCKED_BAND_PA`] and four of the port's noise RMS `noise_pa` of the
-/// block's lowest such reading, if within [`SUCKED_SPREAD_PA`] above `level`. The fill sinks as it gives oil and the
-/// valve's drop grows with the suction flow, so one level for the log lies below the
-/// port wherever the suction is slower or the fill fuller. [Pa]
+/// block's lowest such reading, if within [`SUCKED_SPREAD_PA`] above `level`. The fill
+/// sinks as it gives oil and the valve's drop grows with the suction flow, so one level
+/// for the log lies below the port wherever the suction is slower or the fill fuller. [Pa]
 pub fn sucked_port_track(
     log: &BenchLog,
     start: usize,
