@@ -203,16 +203,15 @@ pub fn hydraulic_residuals(
 }
 
 /// The hydraulic relation's residuals on a moving piston (read − predicted position over
-/// the logged position's noise, [`Hydraulics::predict_position_window`]; `x_logged`
-/// smoothed, so the residuals' own noise lies below that unit and the relation's
-/// likelihood ratios are the conservative side) over `windows`, each window's first row
-/// left out.
+/// the logged position's noise, [`Hydraulics::predict_position_window`]; the position
+/// smoothed ([`LogFacts::x_smooth_m`]), so the residuals' own noise lies below that unit and
+/// the relation's likelihood ratios are the conservative side) over `windows`, each
+/// window's first row left out; none without the position.
 pub fn position_residuals(
     log: &BenchLog,
     facts: &LogFacts,
     rig: &Rig,
     params: HydraulicParams,
-    x_logged: &[f64],
     windows: &[Range<usize>],
 ) -> Vec<f64> {
     let sigma = facts
@@ -221,11 +220,14 @@ pub fn position_residuals(
         .unwrap_or(1e-6);
     let model = Hydraulics::new(params, rig);
     let inputs = HydraulicInputs::of(log, facts);
+    let Some(x_logged) = inputs.x_m else {
+        return Vec::new();
+    };
     windows
         .par_iter()
         .map(|w| {
             let mut pred = vec![0.0; w.len()];
-            model.predict_position_window(&inputs, x_logged, w.clone(), &mut pred);
+            model.predict_position_window(&inputs, w.clone(), &mut pred);
             (w.start + 1..w.end)
                 .map(|k| huber((x_logged[k] - pred[k - w.start]) / sigma))
                 .collect::<Vec<f64>>()
@@ -355,13 +357,12 @@ impl Relation for HydraulicRelation<'_> {
     /// On a moving piston with its position logged, the position's residuals
     /// ([`position_residuals`]); elsewhere the pressure's.
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
-        if let Some(x) = self.moving_piston() {
+        if self.moving_piston().is_some() {
             return position_residuals(
                 self.log,
                 self.facts,
                 self.rig,
                 hydraulic_params(self.rig, values),
-                x,
                 rows,
             );
         }

@@ -279,18 +279,35 @@ pub fn sucked_port_level(log: &BenchLog, start: usize, period_s: f64, noise_pa: 
     let start = start.min(log.len());
     let p = &log.p_pa[start..];
     let lowest = p.iter().copied().fold(f64::INFINITY, f64::min);
-    let band = SUCKED_BAND_PA + 4.0 * noise_pa;
-    let mut held: Vec<f64> = p
-        .iter()
-        .zip(&log.speed_rad_s[start..])
-        .filter(|(p, w)| **w < 0.0 && **p < lowest + band)
-        .map(|(p, _)| *p)
-        .collect();
+    let held = on_the_valve(p, &log.speed_rad_s[start..], 0.0, Some(lowest), noise_pa);
     if (held.len() as f64) * period_s < SUCKED_MIN_S {
         return lowest;
     }
-    held.sort_by(f64::total_cmp);
     held[held.len() / 10]
+}
+
+/// The port's readings `p` at rows where the pump turns backwards (its speed `w` below
+/// −`backwards`) within [`SUCKED_BAND_PA`] and four of the port's noise RMS `noise_pa` of
+/// `lowest` (by default the lowest such reading): the rows its check valve holds it on, in
+/// ascending order. [Pa]
+fn on_the_valve(
+    p: &[f64],
+    w: &[f64],
+    backwards: f64,
+    lowest: Option<f64>,
+    noise_pa: f64,
+) -> Vec<f64> {
+    let sucking = || {
+        p.iter()
+            .zip(w)
+            .filter(|(_, w)| **w < -backwards)
+            .map(|(p, _)| *p)
+    };
+    let lowest = lowest.unwrap_or_else(|| sucking().fold(f64::INFINITY, f64::min));
+    let band = SUCKED_BAND_PA + 4.0 * noise_pa;
+    let mut held: Vec<f64> = sucking().filter(|p| *p < lowest + band).collect();
+    held.sort_by(f64::total_cmp);
+    held
 }
 
 /// Length of the blocks over which [`sucked_port_track`] reads the port's level. [s]
@@ -327,21 +344,12 @@ pub fn sucked_port_track(
     let n = log.len();
     let mut track = vec![level; n];
     let block = ((SUCKED_BLOCK_S / period_s).round() as usize).max(2);
-    let band = SUCKED_BAND_PA + 4.0 * noise_pa;
     let mut b0 = start.min(n);
     while b0 < n {
         let b1 = (b0 + block).min(n);
-        let sucking = || {
-            log.p_pa[b0..b1]
-                .iter()
-                .zip(&log.speed_rad_s[b0..b1])
-                .filter(|(_, w)| **w < -4.0 * speed_noise)
-                .map(|(p, _)| *p)
-        };
-        let lowest = sucking().fold(f64::INFINITY, f64::min);
-        let mut held: Vec<f64> = sucking().filter(|p| *p < lowest + band).collect();
+        let (p, w) = (&log.p_pa[b0..b1], &log.speed_rad_s[b0..b1]);
+        let held = on_the_valve(p, w, 4.0 * speed_noise, None, noise_pa);
         if held.len() as f64 >= SUCKED_BLOCK_SHARE * (b1 - b0) as f64 {
-            held.sort_by(f64::total_cmp);
             let own = held[held.len() / 10];
             if own > level && own <= level + SUCKED_SPREAD_PA {
                 track[b0..b1].fill(own);

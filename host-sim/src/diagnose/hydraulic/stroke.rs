@@ -32,16 +32,18 @@ use std::f64::consts::PI;
 use std::ops::Range;
 
 impl Hydraulics {
-    /// Predicts the piston position `x_logged` (as the relation reads it: smoothed as the
-    /// pressure is) over the window `rows` into `out`, row `rows.start + i` at index i, from
-    /// the pump's swept volume and the port pressure.
+    /// Predicts the piston position of `x` (`x_m`, as the relation reads it: smoothed as
+    /// the pressure is) over the window `rows` into `out`, row `rows.start + i` at index i,
+    /// from the pump's swept volume and the port pressure; nothing without a position.
     pub fn predict_position_window(
         &self,
         x: &HydraulicInputs<'_>,
-        x_logged: &[f64],
         rows: Range<usize>,
         out: &mut [f64],
     ) {
+        let Some(x_logged) = x.x_m else {
+            return;
+        };
         let hp = &self.params;
         let gain = hp.sensor_gain.max(1e-6);
         let p_logged = x.p_smooth_pa.unwrap_or(x.p_pa);
@@ -120,7 +122,7 @@ mod tests {
             fill_track_pa: None,
         };
         let mut out = vec![0.0; n];
-        Hydraulics::new(hp, &Rig::nominal()).predict_position_window(&inputs, x, 0..n, &mut out);
+        Hydraulics::new(hp, &Rig::nominal()).predict_position_window(&inputs, 0..n, &mut out);
         out
     }
 
