@@ -16,6 +16,7 @@ pub mod cylinder;
 pub mod effects;
 pub mod faults;
 pub mod friction;
+mod gaussian;
 pub mod inverter;
 pub mod motor;
 pub mod plant;

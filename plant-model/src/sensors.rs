@@ -10,14 +10,13 @@
 //!
 //! The sensors' faults ([`crate::sensor_faults`]) are applied here, to the readings.
 
+use crate::gaussian::NormalStream;
 use crate::rig::SensorParams;
 use crate::sensor_faults::{
     CurrentFault, EncoderFault, PressureFault, SensorFaultState, SensorFaults,
     LOST_COUNTS_PER_SAMPLE,
 };
 use core::f64::consts::PI;
-use rand_core::{RngCore, SeedableRng};
-use rand_xoshiro::Xoshiro256PlusPlus;
 
 /// What the MCU's peripherals return for one current-loop sample (the control core's
 /// `Measurements`, field for field).
@@ -40,8 +39,7 @@ pub struct SensorReadings {
 pub struct Sensors {
     params: SensorParams,
     pole_pairs: f64,
-    rng: Xoshiro256PlusPlus,
-    spare_normal: Option<f64>,
+    normals: NormalStream,
     last_revolution: Option<i64>,
     faults: SensorFaults,
     fault_state: SensorFaultState,
@@ -55,8 +53,7 @@ impl Sensors {
         Sensors {
             params: params.clone(),
             pole_pairs: pole_pairs as f64,
-            rng: Xoshiro256PlusPlus::seed_from_u64(seed),
-            spare_normal: None,
+            normals: NormalStream::new(seed),
             last_revolution: None,
             faults: SensorFaults::default(),
             fault_state: SensorFaultState::default(),
@@ -99,20 +96,9 @@ impl Sensors {
     }
 
     /// Standard normal deviate (Marsaglia's polar method on the xoshiro stream).
+    #[inline]
     fn normal(&mut self) -> f64 {
-        if let Some(z) = self.spare_normal.take() {
-            return z;
-        }
-        loop {
-            let u = 2.0 * unit(self.rng.next_u64()) - 1.0;
-            let v = 2.0 * unit(self.rng.next_u64()) - 1.0;
-            let s = u * u + v * v;
-            if s > 0.0 && s < 1.0 {
-                let f = libm::sqrt(-2.0 * libm::log(s) / s);
-                self.spare_normal = Some(v * f);
-                return u * f;
-            }
-        }
+        self.normals.next()
     }
 
     fn noise(&mut self, rms: f64) -> f64 {
@@ -281,11 +267,6 @@ impl Sensors {
         };
         (wrap(raw + self.fault_state.encoder_offset), index)
     }
-}
-
-/// Uniform in [0, 1) from the top 53 bits.
-fn unit(x: u64) -> f64 {
-    (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// Rounds to the nearest count and clips to the converter's range.
