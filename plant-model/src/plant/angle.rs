@@ -21,6 +21,19 @@ impl Plant {
         }
     }
 
+    /// The rotor's electrical phasor at `theta`: the kept one when it belongs to it, else the
+    /// shaft phasor's power alone (the flux, cogging and pump terms are not needed for it).
+    #[inline]
+    pub(super) fn rotor_e(&self, theta: f64) -> Phasor {
+        if theta == self.angle.theta {
+            self.angle.rot_e
+        } else if theta == self.rotor.theta {
+            self.rotor.phasor.pow(self.pole_pairs)
+        } else {
+            Phasor::of(theta).pow(self.pole_pairs)
+        }
+    }
+
     /// The shaft-angle terms at `theta` near `a0.theta` (an RK4 stage), its phasor by rotating
     /// `a0`'s through the difference.
     #[inline]

@@ -200,7 +200,7 @@ impl Plant {
 
     /// The motor's phase currents now. [A]
     pub(super) fn motor_phase_currents(&self) -> [f64; 3] {
-        let e = self.angle_terms(self.x[ix::THETA]).rot_e;
+        let e = self.rotor_e(self.x[ix::THETA]);
         dq_to_abc(self.x[ix::ID], self.x[ix::IQ], e.sin, e.cos)
     }
 
@@ -279,7 +279,7 @@ impl Plant {
     /// Puts the currents back on the line (removing what drifted off it, or a phase's
     /// current when it opens) and books the winding energy removed.
     pub(super) fn project_line(&mut self, line: Line) {
-        let e = self.angle_terms(self.x[ix::THETA]).rot_e;
+        let e = self.rotor_e(self.x[ix::THETA]);
         let n = line.idle_phase().line_direction();
         let (id, iq) = (self.x[ix::ID], self.x[ix::IQ]);
         let i = line_current(n, id, iq, e);
