@@ -101,12 +101,9 @@ impl Sensors {
         self.normals.next()
     }
 
+    /// White Gaussian noise of `rms`.
     fn noise(&mut self, rms: f64) -> f64 {
-        if rms > 0.0 {
-            rms * self.normal()
-        } else {
-            0.0
-        }
+        noise(&mut self.normals, rms)
     }
 
     /// Samples every sensor at time `t_s`: the currents through the current sensors `i_abc`
@@ -137,7 +134,7 @@ impl Sensors {
         p_sensed: f64,
         theta_m: f64,
     ) -> SensorReadings {
-        let c = self.params.current.clone();
+        let c = &self.params.current;
         let mut adc_phase_current = [0u16; 3];
         for (k, ((out, i), off)) in adc_phase_current
             .iter_mut()
@@ -145,7 +142,7 @@ impl Sensors {
             .zip(&c.offset_a)
             .enumerate()
         {
-            let n = self.noise(c.noise_a_rms);
+            let n = noise(&mut self.normals, c.noise_a_rms);
             if !FAULTY || self.faults.current.is_none() {
                 *out = quantise(c.zero_lsb + (i + off + n) / c.a_per_lsb, c.bits);
                 continue;
@@ -167,14 +164,14 @@ impl Sensors {
                 }
             }
         }
-        let v = self.params.dc_link.clone();
-        let nv = self.noise(v.noise_v_rms);
+        let v = &self.params.dc_link;
+        let nv = noise(&mut self.normals, v.noise_v_rms);
         let adc_dc_link = quantise((u_dc + nv) / v.v_per_lsb, v.bits);
         let adc_pressure = if FAULTY {
             self.pressure_reading(t_s, p_sensed)
         } else {
-            let p = self.params.pressure.clone();
-            let np = self.noise(p.noise_pa_rms);
+            let p = &self.params.pressure;
+            let np = noise(&mut self.normals, p.noise_pa_rms);
             quantise(
                 p.zero_lsb + (p_sensed + p.offset_pa + np) / p.pa_per_lsb,
                 p.bits,
@@ -266,6 +263,16 @@ impl Sensors {
             }
         };
         (wrap(raw + self.fault_state.encoder_offset), index)
+    }
+}
+
+/// White Gaussian noise of `rms` from `normals` (no draw when `rms` is zero).
+#[inline(always)]
+fn noise(normals: &mut NormalStream, rms: f64) -> f64 {
+    if rms > 0.0 {
+        rms * normals.next()
+    } else {
+        0.0
     }
 }
 
