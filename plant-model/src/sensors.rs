@@ -95,17 +95,6 @@ impl Sensors {
             faults != SensorFaults::default() || self.fault_state != SensorFaultState::default();
     }
 
-    /// Standard normal deviate (Marsaglia's polar method on the xoshiro stream).
-    #[inline]
-    fn normal(&mut self) -> f64 {
-        self.normals.next()
-    }
-
-    /// White Gaussian noise of `rms`.
-    fn noise(&mut self, rms: f64) -> f64 {
-        noise(&mut self.normals, rms)
-    }
-
     /// Samples every sensor at time `t_s`: the currents through the current sensors `i_abc`
     /// (the bridge legs'), DC link `u_dc`, the transducer's (lagged) pressure `p_sensed` and
     /// the shaft angle `theta_m` (unwrapped).
@@ -205,8 +194,8 @@ impl Sensors {
     /// The transducer's ADC result for the (lagged) pressure `p_sensed` at `t_s`, with the
     /// transducer's fault. [counts]
     fn pressure_reading(&mut self, t_s: f64, p_sensed: f64) -> u16 {
-        let p = self.params.pressure.clone();
-        let np = self.noise(p.noise_pa_rms);
+        let p = &self.params.pressure;
+        let np = noise(&mut self.normals, p.noise_pa_rms);
         let full = ((1u32 << p.bits) - 1) as f64;
         let st = &mut self.fault_state;
         let sensed = match self.faults.pressure {
@@ -221,7 +210,9 @@ impl Sensors {
                 let since = *st.drift_since_s.get_or_insert(t_s);
                 p_sensed + pa_per_s * (t_s - since)
             }
-            Some(PressureFault::NoiseBurst { rms_pa }) => p_sensed + self.noise(rms_pa),
+            Some(PressureFault::NoiseBurst { rms_pa }) => {
+                p_sensed + noise(&mut self.normals, rms_pa)
+            }
         };
         quantise(
             p.zero_lsb + (sensed + p.offset_pa + np) / p.pa_per_lsb,
@@ -245,7 +236,7 @@ impl Sensors {
         let (raw, index) = match self.faults.encoder {
             None | Some(EncoderFault::LostCounts { .. }) => (i64::from(count), index),
             Some(EncoderFault::NoiseBurst { counts_rms }) => {
-                let spurious = libm::round(counts_rms * self.normal()) as i64;
+                let spurious = libm::round(counts_rms * self.normals.next()) as i64;
                 let st = &mut self.fault_state;
                 st.encoder_offset += spurious;
                 (i64::from(count), index)

@@ -145,7 +145,7 @@ fn test_relations(
     // tolerance band takes up as well.
     if facts.piston_unseen {
         hyd_releases.clear();
-    } else if r.hydraulic.moving_piston().is_some() {
+    } else if r.hydraulic.moving_piston() {
         hyd_releases.retain(|r| matches!(r, Release::BulkModulus | Release::Precharge));
     }
     let (h, m) = (&cal.hydraulic, &cal.mechanical);

@@ -254,15 +254,12 @@ const DISTINCT_START_RATIO: f64 = 1.03;
 const PRECHARGE_BASINS: usize = 2;
 
 impl HydraulicRelation<'_> {
-    /// The piston position the balance is read for, when the piston moves: the logged one
-    /// smoothed as the pressure is ([`LogFacts::p_smooth_pa`]). Against the raw position
-    /// the smoothed pressure's rounded corners (a cylinder friction's stick-slip turns it
-    /// every few tens of milliseconds) read as a softer oil.
-    pub fn moving_piston(&self) -> Option<&[f64]> {
-        self.facts
-            .x_smooth_m
-            .as_deref()
-            .filter(|_| self.facts.piston_moves)
+    /// Whether the balance is read for the piston's position: the piston moves and its
+    /// position is logged, read smoothed as the pressure is ([`LogFacts::p_smooth_pa`]).
+    /// Against the raw position the smoothed pressure's rounded corners (a cylinder
+    /// friction's stick-slip turns it every few tens of milliseconds) read as a softer oil.
+    pub fn moving_piston(&self) -> bool {
+        self.facts.piston_moves && self.facts.x_smooth_m.is_some()
     }
 
     /// The released precharge's starting grid around the rig file's `p0`: 0.3–3 times it,
@@ -311,7 +308,7 @@ impl Relation for HydraulicRelation<'_> {
     /// calibrated model predicts.
     fn specs(&self, release: Release) -> Vec<ParamSpec> {
         let mut specs = hydraulic_specs(self.rig, release, self.facts.low_side_apart);
-        if self.moving_piston().is_some() {
+        if self.moving_piston() {
             let n = HydraulicParams::nominal(self.rig);
             for (i, value) in [
                 (hyd::GAIN, 1.0),
@@ -357,7 +354,7 @@ impl Relation for HydraulicRelation<'_> {
     /// On a moving piston with its position logged, the position's residuals
     /// ([`position_residuals`]); elsewhere the pressure's.
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
-        if self.moving_piston().is_some() {
+        if self.moving_piston() {
             return position_residuals(
                 self.log,
                 self.facts,

@@ -9,15 +9,24 @@ use crate::motor::Phasor;
 
 impl Plant {
     /// The shaft-angle terms at `theta`: the kept ones when they belong to it, else computed
-    /// (from the kept rotor phasor when that belongs to it, else with one `sincos`).
+    /// from the shaft phasor ([`Plant::shaft_phasor`]).
     #[inline]
     pub(super) fn angle_terms(&self, theta: f64) -> AngleTerms {
         if theta == self.angle.theta {
             self.angle
-        } else if theta == self.rotor.theta {
-            self.angle_terms_of(theta, self.rotor.phasor)
         } else {
-            self.angle_terms_of(theta, Phasor::of(theta))
+            self.angle_terms_of(theta, self.shaft_phasor(theta))
+        }
+    }
+
+    /// The shaft-angle phasor at `theta`: the kept rotor phasor when it belongs to it, else
+    /// one `sincos`.
+    #[inline]
+    fn shaft_phasor(&self, theta: f64) -> Phasor {
+        if theta == self.rotor.theta {
+            self.rotor.phasor
+        } else {
+            Phasor::of(theta)
         }
     }
 
@@ -27,10 +36,8 @@ impl Plant {
     pub(super) fn rotor_e(&self, theta: f64) -> Phasor {
         if theta == self.angle.theta {
             self.angle.rot_e
-        } else if theta == self.rotor.theta {
-            self.rotor.phasor.pow(self.pole_pairs)
         } else {
-            Phasor::of(theta).pow(self.pole_pairs)
+            self.shaft_phasor(theta).pow(self.pole_pairs)
         }
     }
 
