@@ -9,7 +9,7 @@
 
 use crate::bench_log::{BenchLog, Signal};
 pub use crate::diagnose::low_side::LowSide;
-use crate::diagnose::speed_angle::{integrated_angle, AngleSource};
+use crate::diagnose::speed_angle::{angle_count, integrated_angle, AngleSource};
 use crate::diagnose::steady::{
     balanced_boundary, lesser_side, slow_line_speed, slow_windows, steady_windows, SteadyWindow,
     STEADY_MIN_REVOLUTIONS,
@@ -51,6 +51,9 @@ pub struct LogFacts {
     /// Where `theta_rad` comes from: logged, or integrated from the logged speed
     /// ([`crate::diagnose::speed_angle`]), so that its absolute phase is unknown.
     pub angle: AngleSource,
+    /// One encoder count of `theta_rad`, when it moves by whole counts (logged from the
+    /// encoder, or counted back from a count-difference speed). [rad]
+    pub angle_count_rad: Option<f64>,
     /// The rig's fill pressure, the low side's (port B) where the log does not hold it
     /// ([`LogFacts::p_low`]). [Pa]
     pub fill_low_pa: f64,
@@ -125,6 +128,7 @@ impl LogFacts {
             Some(th) => (unwrap_angle(th, t, &log.speed_rad_s), AngleSource::Logged),
             None => integrated_angle(t, &log.speed_rad_s, uniform),
         };
+        let angle_count_rad = angle_count(&theta_rad);
         let fill_low_pa = rig.fill.pressure_pa;
         let p_low = LowSide::of(log, fill_low_pa);
         let piston_moves = log.x_m.as_deref().is_some_and(|x| {
@@ -186,6 +190,7 @@ impl LogFacts {
             uniform,
             theta_rad,
             angle,
+            angle_count_rad,
             fill_low_pa,
             fill_pa,
             fill_track_pa,

@@ -107,6 +107,14 @@ pub fn integrated_angle(t: &[f64], speed: &[f64], evenly_sampled: bool) -> (Vec<
     (theta, source)
 }
 
+/// The angle of one encoder count when the rows' angle `theta` (unwrapped) moves by whole
+/// numbers of it (a logged encoder angle, or one counted back from a count-difference
+/// speed), else `None`: the lattice [`count_step`] finds in its increments. [rad]
+pub fn angle_count(theta: &[f64]) -> Option<f64> {
+    let increments: Vec<f64> = theta.windows(2).map(|w| w[1] - w[0]).collect();
+    count_step(&increments)
+}
+
 /// The angle of one encoder count when every increment ω_k·Δt_k of the log is a whole
 /// number of it (the speed is a count difference over the row), else `None`. [rad]
 ///
@@ -229,6 +237,24 @@ mod tests {
                 th[k]
             );
         }
+    }
+
+    #[test]
+    fn a_logged_encoder_angle_gives_its_count_and_a_smooth_one_none() {
+        // A 16 384-count encoder's angle logged wrapped to [0, 2π) in single precision
+        // every millisecond, unwrapped as the facts unwrap it, and the motion itself: one
+        // count, 2π/16 384, and no lattice.
+        let q = 2.0 * PI / 16_384.0;
+        let t: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
+        let wrapped: Vec<f64> = t
+            .iter()
+            .map(|&t| ((motion(t) / q).floor() * q).rem_euclid(2.0 * PI) as f32 as f64)
+            .collect();
+        let counted = crate::diagnose::facts::unwrap_angle(&wrapped, &t, &[]);
+        let step = angle_count(&counted).expect("a lattice");
+        assert!((step / q - 1.0).abs() < 1e-4, "{step} against {q}");
+        let smooth: Vec<f64> = t.iter().map(|&t| motion(t)).collect();
+        assert_eq!(angle_count(&smooth), None);
     }
 
     #[test]
