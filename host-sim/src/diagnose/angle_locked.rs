@@ -93,8 +93,10 @@ fn regressor(
     }
 }
 
-/// Noise variance per real component of the torque line `o` in window `w`, the candidate
-/// orders `candidates` left out of its floor.
+/// Noise variance per real component of the torque line `o` in window `w`: the floor of
+/// its neighbouring orders (the candidate orders `candidates` left out), the model's
+/// tolerance on the line's current and angle parts, and the torque J·(k·ω̄)² makes of the
+/// line the encoder's rounding alone leaves in the angle ([`super::count_lines`]).
 pub fn torque_variance(
     w: &WindowLines,
     o: &OrderLines,
@@ -106,7 +108,9 @@ pub fn torque_variance(
     let wk = o.order as f64 * w.window.speed_rad_s.abs();
     let current = TORQUE_TOLERANCE * kt * o.iq.norm();
     let angle = TORQUE_TOLERANCE * j * wk * wk * o.theta.norm();
-    floor + 0.5 * (current * current + angle * angle)
+    // The torque the encoder's rounding alone puts on this order's angle line.
+    let counts = j * wk * wk * o.theta_counts;
+    floor + 0.5 * (current * current + angle * angle + counts * counts)
 }
 
 /// A line effect fitted on some windows.

@@ -379,6 +379,7 @@ mod tests {
                 iq: z[0],
                 id: z[1],
                 theta: z[2],
+                theta_counts: 0.0,
                 p: Complex64::default(),
                 torque: Complex64::default(),
                 voltages: Some([z[3], z[4]]),

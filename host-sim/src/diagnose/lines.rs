@@ -17,6 +17,7 @@
 //! and leaves T_k near zero while the d current shows its line.
 
 use crate::bench_log::BenchLog;
+use crate::diagnose::count_lines::count_line_rms;
 use crate::diagnose::facts::LogFacts;
 use crate::diagnose::steady::SteadyWindow;
 use nalgebra::DMatrix;
@@ -53,6 +54,9 @@ pub struct OrderLines {
     pub id: Complex64,
     /// Detrended angle. [rad]
     pub theta: Complex64,
+    /// RMS of the angle line the encoder's counts alone leave at this order
+    /// ([`super::count_lines`]); zero where the angle lies on no count lattice. [rad]
+    pub theta_counts: f64,
     /// Pressure. [Pa]
     pub p: Complex64,
     /// Unexplained torque T_k. [N·m]
@@ -161,67 +165,21 @@ fn analysed_orders(candidates: &[u32], max_order: u32) -> Vec<u32> {
 /// steady only within a band (a sine test's shaft accelerates through it), and the angle's
 /// curvature left by a straight line would leak into the lines, most at the high orders
 /// whose torque weighs the angle's line with J·(k·ω̄)².
-const TREND_TERMS: usize = 4;
+pub(super) const TREND_TERMS: usize = 4;
 
 /// Complex amplitudes of `signals` at `orders` (ascending) over `rows` (each signal a slice
 /// whose first element is the log's row given beside it), by one least-squares fit of a
 /// cubic in time ([`TREND_TERMS`]) and sin/cos of k·θ for every order (the orders are
 /// near-orthogonal over whole revolutions; fitting them together removes what leaks
 /// between them).
-///
-/// The fit is solved through its normal equations, accumulated in one pass over the rows:
-/// the columns are Legendre polynomials and whole-revolution sinusoids, well conditioned,
-/// and the pass costs n·c²/2 against the n·c² several times over of a decomposition of
-/// the n×c design matrix. Each row's sinusoids are powers of one e^{jθ}, not a sine each.
-fn lock_in(
+pub(super) fn lock_in(
     t: &[f64],
     theta: &[f64],
     rows: std::ops::Range<usize>,
     orders: &[u32],
     signals: &[(&[f64], usize)],
 ) -> Option<Vec<Vec<Complex64>>> {
-    let n = rows.len();
-    let cols = TREND_TERMS + 2 * orders.len();
-    if n < 2 * cols {
-        return None;
-    }
-    let t0 = t[rows.start];
-    let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
-    let mut gram = DMatrix::<f64>::zeros(cols, cols);
-    let mut rhs = DMatrix::<f64>::zeros(cols, signals.len());
-    let mut phi = vec![0.0; cols];
-    for k in rows.clone() {
-        // Legendre polynomials of the window's time on [−1, 1]: well conditioned.
-        let x = 2.0 * (t[k] - t0) / span - 1.0;
-        phi[..TREND_TERMS].copy_from_slice(&[1.0, x, 1.5 * x * x - 0.5, 2.5 * x * x * x - 1.5 * x]);
-        let (s1, c1) = theta[k].sin_cos();
-        let base = Complex64::new(c1, s1);
-        let mut z = Complex64::new(1.0, 0.0);
-        let mut last = 0;
-        for (m, &order) in orders.iter().enumerate() {
-            z *= base.powu(order - last);
-            last = order;
-            phi[TREND_TERMS + 2 * m] = z.re;
-            phi[TREND_TERMS + 2 * m + 1] = z.im;
-        }
-        for i in 0..cols {
-            let pi = phi[i];
-            for j in i..cols {
-                gram[(i, j)] += pi * phi[j];
-            }
-        }
-        for (s, (y, offset)) in signals.iter().enumerate() {
-            let v = y[k - offset];
-            for (i, p) in phi.iter().enumerate() {
-                rhs[(i, s)] += p * v;
-            }
-        }
-    }
-    gram.fill_lower_triangle_with_upper_triangle();
-    let x = match gram.clone().cholesky() {
-        Some(c) => c.solve(&rhs),
-        None => gram.svd(true, true).solve(&rhs, 1e-12).ok()?,
-    };
+    let x = trend_and_lines(t, theta, rows, orders, signals)?;
     Some(
         (0..signals.len())
             .map(|s| {
@@ -236,6 +194,71 @@ fn lock_in(
             })
             .collect(),
     )
+}
+
+/// The regressors of the row at time `t` and angle `theta` of a window starting at `t0` and
+/// `span` long: the Legendre polynomials of the window's time on [−1, 1] (well
+/// conditioned), then cos and sin of k·θ for each of `orders` (ascending), written to `phi`.
+/// The sinusoids are powers of one e^{jθ}, not a sine each.
+pub(super) fn regressors(t: f64, t0: f64, span: f64, theta: f64, orders: &[u32], phi: &mut [f64]) {
+    let x = 2.0 * (t - t0) / span - 1.0;
+    phi[..TREND_TERMS].copy_from_slice(&[1.0, x, 1.5 * x * x - 0.5, 2.5 * x * x * x - 1.5 * x]);
+    let (s1, c1) = theta.sin_cos();
+    let base = Complex64::new(c1, s1);
+    let mut z = Complex64::new(1.0, 0.0);
+    let mut last = 0;
+    for (m, &order) in orders.iter().enumerate() {
+        z *= base.powu(order - last);
+        last = order;
+        phi[TREND_TERMS + 2 * m] = z.re;
+        phi[TREND_TERMS + 2 * m + 1] = z.im;
+    }
+}
+
+/// The least-squares coefficients of [`regressors`] for each of `signals` over `rows`, a
+/// column per signal, `None` for too few rows.
+///
+/// The fit is solved through its normal equations, accumulated in one pass over the rows:
+/// the columns are Legendre polynomials and whole-revolution sinusoids, well conditioned,
+/// and the pass costs n·c²/2 against the n·c² several times over of a decomposition of
+/// the n×c design matrix.
+pub(super) fn trend_and_lines(
+    t: &[f64],
+    theta: &[f64],
+    rows: std::ops::Range<usize>,
+    orders: &[u32],
+    signals: &[(&[f64], usize)],
+) -> Option<DMatrix<f64>> {
+    let n = rows.len();
+    let cols = TREND_TERMS + 2 * orders.len();
+    if n < 2 * cols {
+        return None;
+    }
+    let t0 = t[rows.start];
+    let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
+    let mut gram = DMatrix::<f64>::zeros(cols, cols);
+    let mut rhs = DMatrix::<f64>::zeros(cols, signals.len());
+    let mut phi = vec![0.0; cols];
+    for k in rows.clone() {
+        regressors(t[k], t0, span, theta[k], orders, &mut phi);
+        for i in 0..cols {
+            let pi = phi[i];
+            for j in i..cols {
+                gram[(i, j)] += pi * phi[j];
+            }
+        }
+        for (s, (y, offset)) in signals.iter().enumerate() {
+            let v = y[k - offset];
+            for (i, p) in phi.iter().enumerate() {
+                rhs[(i, s)] += p * v;
+            }
+        }
+    }
+    gram.fill_lower_triangle_with_upper_triangle();
+    match gram.clone().cholesky() {
+        Some(c) => Some(c.solve(&rhs)),
+        None => gram.svd(true, true).solve(&rhs, 1e-12).ok(),
+    }
 }
 
 /// The lines of every steady window at `candidates` (and their neighbours), with the
@@ -294,6 +317,10 @@ pub fn window_lines(
                 signals.extend([(d.as_slice(), rows.start), (q.as_slice(), rows.start)]);
             }
             let z = lock_in(t, theta, rows.clone(), &orders, &signals)?;
+            let counts = facts
+                .angle_count_rad
+                .and_then(|q| count_line_rms(t, theta, rows.clone(), &orders, q))
+                .unwrap_or_else(|| vec![0.0; orders.len()]);
             let lines = orders
                 .iter()
                 .enumerate()
@@ -305,6 +332,7 @@ pub fn window_lines(
                         iq,
                         id,
                         theta: th,
+                        theta_counts: counts[m],
                         p,
                         torque: iq * kt + th * (j * wk * wk) - p * d_per_rad,
                         voltages: voltages.map(|_| [z[4][m], z[5][m]]),

@@ -37,6 +37,7 @@ pub mod calibration;
 pub mod candidates;
 pub mod command;
 pub mod contributions;
+pub mod count_lines;
 pub mod cylinder;
 pub mod dead_time;
 pub mod decision;
