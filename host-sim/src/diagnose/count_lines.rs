@@ -22,7 +22,7 @@
 //! lines over the shifts and drifts is the line the counts alone leave at each order:
 //! noise for the torque balance, as the neighbouring orders' lines are.
 
-use super::lines::{regressors, trend_and_lines, TREND_TERMS};
+use super::lock_in::{lock_in, regressors, trend_and_lines, TREND_TERMS};
 use std::ops::Range;
 
 /// The angle's own orders kept in its smoothed motion (1 to this): the electrical order and
@@ -64,7 +64,7 @@ pub fn count_line_rms(
         })
         .collect();
     let signals: Vec<(&[f64], usize)> = errors.iter().map(|e| (e.as_slice(), rows.start)).collect();
-    let lines = super::lines::lock_in(t, theta, rows, orders, &signals)?;
+    let lines = lock_in(t, theta, rows, orders, &signals)?;
     Some(
         (0..orders.len())
             .map(|m| {
@@ -116,8 +116,7 @@ mod tests {
     /// see): the lock-in of counted minus true. [rad]
     fn true_rounding_lines(t: &[f64], counted: &[f64], truth: &[f64], orders: &[u32]) -> Vec<f64> {
         let err: Vec<f64> = counted.iter().zip(truth).map(|(c, a)| c - a).collect();
-        let z = crate::diagnose::lines::lock_in(t, counted, 0..t.len(), orders, &[(&err, 0)])
-            .expect("lines");
+        let z = lock_in(t, counted, 0..t.len(), orders, &[(&err, 0)]).expect("lines");
         z[0].iter().map(|z| z.norm()).collect()
     }
 

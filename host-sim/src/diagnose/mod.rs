@@ -56,6 +56,7 @@ pub mod intervals;
 pub mod least_squares;
 pub mod line_split;
 pub mod lines;
+pub mod lock_in;
 pub mod loop_response;
 pub mod low_side;
 pub mod mechanical;
