@@ -76,6 +76,10 @@ const MAX_ROUNDING_RMS: f64 = 8.0;
 /// Largest distance of 2π over the step from a whole number of counts per revolution. [1]
 const COUNTS_PER_REV_TOLERANCE: f64 = 0.05;
 
+/// Largest increment, in counts, the step is first refined on ([`on_lattice`]): its count
+/// is rounded right by a step up to 1/16 off. [1]
+const FEW_COUNTS: f64 = 8.0;
+
 /// Most step sizes tried, an octave apart: from a double's rounding (1e-16 rad) to a
 /// count of a coarse encoder (0.1 rad) is 50 octaves.
 const MAX_TRIES: usize = 64;
@@ -158,12 +162,26 @@ fn count_step(increments: &[f64]) -> Option<f64> {
 
 /// The step refined by least squares on the counts `step` assigns to the `moving`
 /// increments, when they lie on its lattice with the counter's jitter (module docs).
+///
+/// The refinement is taken first on the increments of at most [`FEW_COUNTS`], whose counts
+/// a step some percent off still rounds right, then on all: a candidate read from a
+/// single-precision angle's rounding (a multi-turn angle of tens of radians is rounded to a
+/// hundredth of a fine encoder's count) is off by that much, and rounded with it an
+/// increment of sixty counts would be given sixty-one.
 fn on_lattice(increments: &[f64], moving: &[f64], step: f64) -> Option<f64> {
     let counts = |step: f64| moving.iter().map(move |d| (d / step).round());
-    let (num, den) = counts(step)
-        .zip(moving)
-        .fold((0.0, 0.0), |(num, den), (c, d)| (num + c * d, den + c * c));
-    let step = if den > 0.0 { num / den } else { step };
+    let refined = |step: f64, most: f64| {
+        let (num, den) = counts(step)
+            .zip(moving)
+            .filter(|(c, _)| c.abs() <= most)
+            .fold((0.0, 0.0), |(num, den), (c, d)| (num + c * d, den + c * c));
+        if den > 0.0 {
+            num / den
+        } else {
+            step
+        }
+    };
+    let step = refined(refined(step, FEW_COUNTS), f64::INFINITY);
     // A moving increment is at least one count.
     let on = counts(step)
         .zip(moving)
@@ -252,6 +270,14 @@ mod tests {
             .collect();
         let counted = crate::diagnose::facts::unwrap_angle(&wrapped, &t, &[]);
         let step = angle_count(&counted).expect("a lattice");
+        assert!((step / q - 1.0).abs() < 1e-4, "{step} against {q}");
+        // Logged unwrapped in single precision, the angle reaches 48 rad, where its rounding
+        // is 1 % of a count: still the count.
+        let multi_turn: Vec<f64> = t
+            .iter()
+            .map(|&t| ((motion(t) / q).floor() * q) as f32 as f64)
+            .collect();
+        let step = angle_count(&multi_turn).expect("a lattice");
         assert!((step / q - 1.0).abs() < 1e-4, "{step} against {q}");
         let smooth: Vec<f64> = t.iter().map(|&t| motion(t)).collect();
         assert_eq!(angle_count(&smooth), None);
