@@ -23,6 +23,7 @@
 //! noise for the torque balance, as the neighbouring orders' lines are.
 
 use super::lock_in::{lock_in, regressors, trend_and_lines, TREND_TERMS};
+use rustfft::num_complex::Complex64;
 use std::ops::Range;
 
 /// The angle's own orders kept in its smoothed motion (1 to this): the electrical order and
@@ -37,10 +38,10 @@ pub const SHIFTS: usize = 8;
 /// the mean speed's uncertainty of about a count over the window. [count]
 pub const DRIFTS: [f64; 3] = [-0.5, 0.0, 0.5];
 
-/// RMS over [`SHIFTS`] of the line the rounding to `count` (one encoder count, [rad])
-/// leaves at each of `orders` (ascending) in the angle `theta` (unwrapped, the lock-in's
-/// reference as well) over `rows` at times `t`: the module's method. `None` where the
-/// window is too short for the fit. [rad]
+/// RMS over [`SHIFTS`] and [`DRIFTS`] of the line the rounding to `count` (one encoder
+/// count, [rad]) leaves at each of `orders` (ascending) in the angle `theta` (unwrapped,
+/// the lock-in's reference as well) over `rows` at times `t`: the module's method. `None`
+/// where the window is too short for the fit. [rad]
 pub fn count_line_rms(
     t: &[f64],
     theta: &[f64],
@@ -48,31 +49,49 @@ pub fn count_line_rms(
     orders: &[u32],
     count: f64,
 ) -> Option<Vec<f64>> {
+    let errors = rounding_errors(t, theta, rows.clone(), count)?;
+    let signals: Vec<(&[f64], usize)> = errors.iter().map(|e| (e.as_slice(), rows.start)).collect();
+    Some(rms_over_shifts(&lock_in(t, theta, rows, orders, &signals)?))
+}
+
+/// The rounding errors of the smoothed angle over `rows` (the first row's error first), one
+/// series per shift and drift, for a lock-in to read beside other signals (it fits each
+/// signal on its own, so the lines are the same as [`count_line_rms`]'s). [rad]
+pub fn rounding_errors(
+    t: &[f64],
+    theta: &[f64],
+    rows: Range<usize>,
+    count: f64,
+) -> Option<Vec<Vec<f64>>> {
     let smooth = smoothed_angle(t, theta, rows.clone())?;
     let (t0, t1) = (t[rows.start], t[rows.end - 1]);
     let span = (t1 - t0).max(f64::MIN_POSITIVE);
-    let errors: Vec<Vec<f64>> = (0..SHIFTS)
-        .flat_map(|m| DRIFTS.map(|drift| (m as f64 / SHIFTS as f64, drift)))
-        .map(|(start, drift)| {
-            rows.clone()
-                .zip(&smooth)
-                .map(|(k, a)| {
-                    let shifted = a / count + start + drift * (t[k] - t0) / span;
-                    (shifted.floor() - shifted) * count
-                })
-                .collect()
-        })
-        .collect();
-    let signals: Vec<(&[f64], usize)> = errors.iter().map(|e| (e.as_slice(), rows.start)).collect();
-    let lines = lock_in(t, theta, rows, orders, &signals)?;
     Some(
-        (0..orders.len())
-            .map(|m| {
-                let power: f64 = lines.iter().map(|shifted| shifted[m].norm_sqr()).sum();
-                (power / lines.len() as f64).sqrt()
+        (0..SHIFTS)
+            .flat_map(|m| DRIFTS.map(|drift| (m as f64 / SHIFTS as f64, drift)))
+            .map(|(start, drift)| {
+                rows.clone()
+                    .zip(&smooth)
+                    .map(|(k, a)| {
+                        let shifted = a / count + start + drift * (t[k] - t0) / span;
+                        (shifted.floor() - shifted) * count
+                    })
+                    .collect()
             })
             .collect(),
     )
+}
+
+/// Per order, the RMS of the lines of [`rounding_errors`]' series (`lines[series][order]`).
+/// [rad]
+pub fn rms_over_shifts(lines: &[Vec<Complex64>]) -> Vec<f64> {
+    let orders = lines.first().map_or(0, Vec::len);
+    (0..orders)
+        .map(|m| {
+            let power: f64 = lines.iter().map(|shifted| shifted[m].norm_sqr()).sum();
+            (power / lines.len() as f64).sqrt()
+        })
+        .collect()
 }
 
 /// `theta` over `rows` smoothed: its least-squares cubic in time and lines at orders 1 to

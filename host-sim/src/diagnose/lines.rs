@@ -17,7 +17,7 @@
 //! and leaves T_k near zero while the d current shows its line.
 
 use crate::bench_log::BenchLog;
-use crate::diagnose::count_lines::count_line_rms;
+use crate::diagnose::count_lines::{rms_over_shifts, rounding_errors};
 use crate::diagnose::facts::LogFacts;
 use crate::diagnose::lock_in::lock_in;
 use crate::diagnose::steady::SteadyWindow;
@@ -216,11 +216,19 @@ pub fn window_lines(
             for (d, q) in &dead_time {
                 signals.extend([(d.as_slice(), rows.start), (q.as_slice(), rows.start)]);
             }
-            let z = lock_in(t, theta, rows.clone(), &orders, &signals)?;
-            let counts = facts
+            // The encoder's rounding (`count_lines`), read in the same fit.
+            let rounding = facts
                 .angle_count_rad
-                .and_then(|q| count_line_rms(t, theta, rows.clone(), &orders, q))
-                .unwrap_or_else(|| vec![0.0; orders.len()]);
+                .and_then(|q| rounding_errors(t, theta, rows.clone(), q))
+                .unwrap_or_default();
+            let first_rounding = signals.len();
+            signals.extend(rounding.iter().map(|e| (e.as_slice(), rows.start)));
+            let z = lock_in(t, theta, rows.clone(), &orders, &signals)?;
+            let counts = if rounding.is_empty() {
+                vec![0.0; orders.len()]
+            } else {
+                rms_over_shifts(&z[first_rounding..])
+            };
             let lines = orders
                 .iter()
                 .enumerate()
