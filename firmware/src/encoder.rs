@@ -185,7 +185,7 @@ impl Encoder {
     /// p_n·2π·count/N, the electrical angle in the counter's own frame (no offset). [rad]
     #[inline]
     pub fn raw_electrical_angle(&self, count: u32) -> f32 {
-        (count % self.counts_per_rev) as f32 * self.elec_rad_per_count
+        self.within_rev(count) as f32 * self.elec_rad_per_count
     }
 
     /// Mechanical angle of a count in [0, 2π), from the index once it is known (from the
@@ -193,7 +193,7 @@ impl Encoder {
     #[inline]
     pub fn mechanical_angle(&self, count: u32) -> f32 {
         let n = self.counts_per_rev.get();
-        let c = count % n;
+        let c = self.within_rev(count);
         let from_index = match self.index_count {
             Some(i) if c >= i => c - i,
             Some(i) => c + (n - i),
@@ -226,12 +226,24 @@ impl Encoder {
         }
     }
 
+    /// `count` modulo the counts per revolution. A timer counting modulo N (its reload at
+    /// N − 1) already reads below N, and then no division is taken: the ISR reads three
+    /// angles of each sample, and a division is the longest instruction of its chain.
+    #[inline]
+    fn within_rev(&self, count: u32) -> u32 {
+        if count < self.counts_per_rev.get() {
+            count
+        } else {
+            count % self.counts_per_rev
+        }
+    }
+
     /// Takes one sample: the counter `count`, whether an index pulse was captured since
     /// the previous sample, and the captured counter value `index_count`; returns what it
     /// revealed.
     #[inline]
     pub fn update(&mut self, count: u32, index: bool, index_count: u32) -> EncoderEvent {
-        let count = count % self.counts_per_rev;
+        let count = self.within_rev(count);
         if !self.primed {
             self.primed = true;
             self.last_count = count;
@@ -244,7 +256,7 @@ impl Encoder {
             event = EncoderEvent::Jump;
         }
         if index {
-            self.on_index(count, index_count % self.counts_per_rev, &mut event);
+            self.on_index(count, self.within_rev(index_count), &mut event);
         } else {
             self.since_index = self.since_index.saturating_add(delta);
             let n = self.counts_per_rev.get() as i32;
