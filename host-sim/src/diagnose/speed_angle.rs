@@ -1,4 +1,5 @@
-//! The shaft angle of a log without `theta_m_rad`, integrated from its speed column.
+//! The shaft angle of a log without `theta_m_rad`, integrated from its speed column, and
+//! the encoder count an angle moves by ([`angle_count`]).
 //!
 //! A bench's speed column is one of two kinds, and the angles they integrate to differ by
 //! half a row:
