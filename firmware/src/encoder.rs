@@ -330,6 +330,26 @@ mod tests {
     }
 
     #[test]
+    fn a_free_running_counter_reads_as_its_count_within_the_revolution() {
+        // A 16-bit timer that is not reset at N: 65 535 and 5 535 are the same place of a
+        // 10 000-count shaft (65 535 = 6·10 000 + 5 535), and a step from 65 530 to 65 535
+        // is five counts.
+        let wrapped = Encoder::new(10_000, 4, 0.3, 50);
+        let mut free = Encoder::new(10_000, 4, 0.3, 50);
+        assert_eq!(free.update(65_530, false, 0), EncoderEvent::Ok);
+        assert_eq!(free.update(65_535, false, 0), EncoderEvent::Ok);
+        assert_eq!(free.position(), 5);
+        assert_eq!(
+            free.mechanical_angle(65_535),
+            wrapped.mechanical_angle(5_535)
+        );
+        assert_eq!(
+            free.electrical_angle(65_535),
+            wrapped.electrical_angle(5_535)
+        );
+    }
+
+    #[test]
     fn jump_and_lost_index() {
         let mut e = Encoder::new(10_000, 4, 0.0, 20);
         e.update(100, false, 0);

@@ -22,7 +22,7 @@
 //! lines over the shifts and drifts is the line the counts alone leave at each order:
 //! noise for the torque balance, as the neighbouring orders' lines are.
 
-use super::lock_in::{lock_in, regressors, trend_and_lines, TREND_TERMS};
+use super::lock_in::{regressors, trend_and_lines, window_clock, TREND_TERMS};
 use rustfft::num_complex::Complex64;
 use std::ops::Range;
 
@@ -38,25 +38,11 @@ pub const SHIFTS: usize = 8;
 /// the mean speed's uncertainty of about a count over the window. [count]
 pub const DRIFTS: [f64; 3] = [-0.5, 0.0, 0.5];
 
-/// RMS over [`SHIFTS`] and [`DRIFTS`] of the line the rounding to `count` (one encoder
-/// count, [rad]) leaves at each of `orders` (ascending) in the angle `theta` (unwrapped,
-/// the lock-in's reference as well) over `rows` at times `t`: the module's method. `None`
-/// where the window is too short for the fit. [rad]
-pub fn count_line_rms(
-    t: &[f64],
-    theta: &[f64],
-    rows: Range<usize>,
-    orders: &[u32],
-    count: f64,
-) -> Option<Vec<f64>> {
-    let errors = rounding_errors(t, theta, rows.clone(), count)?;
-    let signals: Vec<(&[f64], usize)> = errors.iter().map(|e| (e.as_slice(), rows.start)).collect();
-    Some(rms_over_shifts(&lock_in(t, theta, rows, orders, &signals)?))
-}
-
-/// The rounding errors of the smoothed angle over `rows` (the first row's error first), one
-/// series per shift and drift, for a lock-in to read beside other signals (it fits each
-/// signal on its own, so the lines are the same as [`count_line_rms`]'s). [rad]
+/// The rounding errors to `count` (one encoder count, [rad]) of the angle `theta`
+/// (unwrapped) smoothed over `rows` at times `t`, the first row's error first: one series
+/// per shift and drift, for the window's lock-in to read beside its signals (it fits each
+/// signal on its own). `None` where the window is too short for the smoothing's
+/// fit. [rad]
 pub fn rounding_errors(
     t: &[f64],
     theta: &[f64],
@@ -64,8 +50,7 @@ pub fn rounding_errors(
     count: f64,
 ) -> Option<Vec<Vec<f64>>> {
     let smooth = smoothed_angle(t, theta, rows.clone())?;
-    let (t0, t1) = (t[rows.start], t[rows.end - 1]);
-    let span = (t1 - t0).max(f64::MIN_POSITIVE);
+    let (t0, span) = window_clock(t, rows.clone());
     Some(
         (0..SHIFTS)
             .flat_map(|m| DRIFTS.map(|drift| (m as f64 / SHIFTS as f64, drift)))
@@ -82,8 +67,8 @@ pub fn rounding_errors(
     )
 }
 
-/// Per order, the RMS of the lines of [`rounding_errors`]' series (`lines[series][order]`).
-/// [rad]
+/// Per order, the RMS over the shifts and drifts of the lines of [`rounding_errors`]'
+/// series (`lines[series][order]`): the line the counts alone leave there. [rad]
 pub fn rms_over_shifts(lines: &[Vec<Complex64>]) -> Vec<f64> {
     let orders = lines.first().map_or(0, Vec::len);
     (0..orders)
@@ -99,8 +84,7 @@ pub fn rms_over_shifts(lines: &[Vec<Complex64>]) -> Vec<f64> {
 fn smoothed_angle(t: &[f64], theta: &[f64], rows: Range<usize>) -> Option<Vec<f64>> {
     let orders: Vec<u32> = (1..=SMOOTH_ORDERS).collect();
     let c = trend_and_lines(t, theta, rows.clone(), &orders, &[(theta, 0)])?;
-    let t0 = t[rows.start];
-    let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
+    let (t0, span) = window_clock(t, rows.clone());
     let mut phi = vec![0.0; TREND_TERMS + 2 * orders.len()];
     Some(
         rows.map(|k| {
@@ -114,7 +98,23 @@ fn smoothed_angle(t: &[f64], theta: &[f64], rows: Range<usize>) -> Option<Vec<f6
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::lock_in::lock_in;
     use std::f64::consts::PI;
+
+    /// The module's method as the window's lines use it, on the rounding's series alone:
+    /// the line the counts leave at each of `orders`. [rad]
+    fn count_line_rms(
+        t: &[f64],
+        theta: &[f64],
+        rows: Range<usize>,
+        orders: &[u32],
+        count: f64,
+    ) -> Option<Vec<f64>> {
+        let errors = rounding_errors(t, theta, rows.clone(), count)?;
+        let signals: Vec<(&[f64], usize)> =
+            errors.iter().map(|e| (e.as_slice(), rows.start)).collect();
+        Some(rms_over_shifts(&lock_in(t, theta, rows, orders, &signals)?))
+    }
 
     /// A shaft at `w` rad/s with a speed ripple of `ripple` rad/s at order 4, read by a
     /// `counts`-count encoder every `dt` s: times, the counted angle and the true one. [rad]

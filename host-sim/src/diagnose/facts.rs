@@ -124,11 +124,14 @@ impl LogFacts {
         let t = &log.t_s;
         let period_s = median_period(t);
         let uniform = evenly_sampled(t, period_s);
-        let (theta_rad, angle) = match log.theta_m_rad.as_deref() {
-            Some(th) => (unwrap_angle(th, t, &log.speed_rad_s), AngleSource::Logged),
+        let (theta_rad, angle, angle_count_rad) = match log.theta_m_rad.as_deref() {
+            Some(th) => {
+                let theta = unwrap_angle(th, t, &log.speed_rad_s);
+                let count = angle_count(&theta);
+                (theta, AngleSource::Logged, count)
+            }
             None => integrated_angle(t, &log.speed_rad_s, uniform),
         };
-        let angle_count_rad = angle_count(&theta_rad);
         let fill_low_pa = rig.fill.pressure_pa;
         let p_low = LowSide::of(log, fill_low_pa);
         let piston_moves = log.x_m.as_deref().is_some_and(|x| {

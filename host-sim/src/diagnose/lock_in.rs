@@ -40,6 +40,13 @@ pub fn lock_in(
     )
 }
 
+/// The start time of the window `rows` and its span (never zero), which [`regressors`]
+/// map onto [−1, 1]. [s]
+pub fn window_clock(t: &[f64], rows: std::ops::Range<usize>) -> (f64, f64) {
+    let t0 = t[rows.start];
+    (t0, (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE))
+}
+
 /// The regressors of the row at time `t` and angle `theta` of a window starting at `t0` and
 /// `span` long: the Legendre polynomials of the window's time on [−1, 1] (well
 /// conditioned), then cos and sin of k·θ for each of `orders` (ascending), written to `phi`.
@@ -78,8 +85,7 @@ pub fn trend_and_lines(
     if n < 2 * cols {
         return None;
     }
-    let t0 = t[rows.start];
-    let span = (t[rows.end - 1] - t0).max(f64::MIN_POSITIVE);
+    let (t0, span) = window_clock(t, rows.clone());
     let mut gram = DMatrix::<f64>::zeros(cols, cols);
     let mut rhs = DMatrix::<f64>::zeros(cols, signals.len());
     let mut phi = vec![0.0; cols];

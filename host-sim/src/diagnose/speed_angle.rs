@@ -86,12 +86,21 @@ const FEW_COUNTS: f64 = 8.0;
 const MAX_TRIES: usize = 64;
 
 /// The shaft angle the logged `speed` integrates to from 0 at the times `t`, by the rule its
-/// kind asks for (module docs), and which kind it was. Only an `evenly_sampled` log (the
-/// facts' test) is read as counted. [rad]
-pub fn integrated_angle(t: &[f64], speed: &[f64], evenly_sampled: bool) -> (Vec<f64>, AngleSource) {
+/// kind asks for (module docs), which kind it was, and for a counted angle its count. Only
+/// an `evenly_sampled` log (the facts' test) is read as counted. [rad]
+pub fn integrated_angle(
+    t: &[f64],
+    speed: &[f64],
+    evenly_sampled: bool,
+) -> (Vec<f64>, AngleSource, Option<f64>) {
     let n = t.len().min(speed.len());
     let increments: Vec<f64> = (1..n).map(|k| speed[k] * (t[k] - t[k - 1])).collect();
-    let counted = evenly_sampled && count_step(&increments).is_some();
+    let count = if evenly_sampled {
+        count_step(&increments)
+    } else {
+        None
+    };
+    let counted = count.is_some();
     let mut theta = Vec::with_capacity(n);
     let mut acc = 0.0;
     for k in 0..n {
@@ -109,12 +118,12 @@ pub fn integrated_angle(t: &[f64], speed: &[f64], evenly_sampled: bool) -> (Vec<
     } else {
         AngleSource::Integrated
     };
-    (theta, source)
+    (theta, source, count)
 }
 
-/// The angle of one encoder count when the rows' angle `theta` (unwrapped) moves by whole
-/// numbers of it (a logged encoder angle, or one counted back from a count-difference
-/// speed), else `None`: the lattice [`count_step`] finds in its increments. [rad]
+/// The angle of one encoder count when the logged angle `theta` (unwrapped) moves by whole
+/// numbers of it, else `None`: the lattice [`count_step`] finds in its increments (a speed
+/// column's count comes with [`integrated_angle`]). [rad]
 pub fn angle_count(theta: &[f64]) -> Option<f64> {
     let increments: Vec<f64> = theta.windows(2).map(|w| w[1] - w[0]).collect();
     count_step(&increments)
@@ -217,12 +226,20 @@ mod tests {
         3.0 * t * t + 0.2 * (40.0 * t).sin()
     }
 
+    /// The counted angle of `motion` on a `q`-rad lattice, logged wrapped to [0, 2π) in
+    /// single precision, at the times `t`. [rad]
+    fn logged_wrapped(t: &[f64], q: f64) -> Vec<f64> {
+        t.iter()
+            .map(|&t| ((motion(t) / q).floor() * q).rem_euclid(2.0 * PI) as f32 as f64)
+            .collect()
+    }
+
     #[test]
     fn the_speed_integrates_to_the_angle_turned() {
         // A ramp 0 → 20 rad/s over 1 s turns ½·20·1 = 10 rad (trapezoids are exact on a ramp).
         let t: Vec<f64> = (0..1001).map(|k| k as f64 * 1e-3).collect();
         let w: Vec<f64> = t.iter().map(|&t| 20.0 * t).collect();
-        let (th, _) = integrated_angle(&t, &w, true);
+        let (th, ..) = integrated_angle(&t, &w, true);
         assert!((th[1000] - 10.0).abs() < 1e-9, "{}", th[1000]);
     }
 
@@ -247,7 +264,7 @@ mod tests {
         let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
         let step = count_step(&increments).expect("a lattice");
         assert!((step / q - 1.0).abs() < 1e-4, "{step} against {q}");
-        let (th, _) = integrated_angle(&t, &w, true);
+        let (th, ..) = integrated_angle(&t, &w, true);
         for k in (0..t.len()).step_by(97) {
             let counted = (counts[k] - counts[0]) * q;
             assert!(
@@ -265,11 +282,7 @@ mod tests {
         // count, 2π/16 384, and no lattice.
         let q = 2.0 * PI / 16_384.0;
         let t: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
-        let wrapped: Vec<f64> = t
-            .iter()
-            .map(|&t| ((motion(t) / q).floor() * q).rem_euclid(2.0 * PI) as f32 as f64)
-            .collect();
-        let counted = crate::diagnose::facts::unwrap_angle(&wrapped, &t, &[]);
+        let counted = crate::diagnose::facts::unwrap_angle(&logged_wrapped(&t, q), &t, &[]);
         let step = angle_count(&counted).expect("a lattice");
         assert!((step / q - 1.0).abs() < 1e-4, "{step} against {q}");
         // Logged unwrapped in single precision, the angle reaches 48 rad, where its rounding
@@ -295,7 +308,7 @@ mod tests {
             .collect();
         let increments: Vec<f64> = (1..t.len()).map(|k| w[k] * 1e-3).collect();
         assert_eq!(count_step(&increments), None);
-        let (th, _) = integrated_angle(&t, &w, true);
+        let (th, ..) = integrated_angle(&t, &w, true);
         let bound = 4.0 * 1e-6 / 12.0 * 0.2 * 40.0f64.powi(3);
         for k in (0..t.len()).step_by(97) {
             let truth = motion(t[k]) - motion(0.0);
@@ -314,10 +327,7 @@ mod tests {
         // revolution, and the step is the count above that cluster.
         let q = 2.0 * PI / 10_000.0;
         let t: Vec<f64> = (0..4000).map(|k| k as f64 * 1e-3).collect();
-        let theta: Vec<f64> = t
-            .iter()
-            .map(|&t| ((motion(t) / q).floor() * q).rem_euclid(2.0 * PI) as f32 as f64)
-            .collect();
+        let theta = logged_wrapped(&t, q);
         let increments: Vec<f64> = (1..t.len())
             .map(|k| {
                 let d = theta[k] - theta[k - 1];
@@ -362,11 +372,11 @@ mod tests {
             })
             .collect();
         let even = |t: &[f64]| evenly_sampled(t, median_period(t));
-        let (_, source) = integrated_angle(&t, &w, even(&t));
+        let (_, source, _) = integrated_angle(&t, &w, even(&t));
         assert_eq!(source, AngleSource::Integrated);
         let mut w = vec![0.0];
         w.extend((1..all.len()).map(|k| (counts[k] - counts[k - 1]) * q / 1e-3));
-        let (_, source) = integrated_angle(&all, &w, even(&all));
+        let (_, source, _) = integrated_angle(&all, &w, even(&all));
         assert_eq!(source, AngleSource::Counted);
     }
 
