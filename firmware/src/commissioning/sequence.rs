@@ -230,226 +230,268 @@ impl Commissioning {
     pub fn step(&mut self, x: &Input) -> Action {
         self.n = self.n.saturating_add(1);
         self.total = self.total.saturating_add(1);
-        let i_max = self.c.current_a;
-        let n = self.n;
         match self.phase {
             Phase::Idle | Phase::Done => Action::Off,
             Phase::Failed => Action::Off,
             Phase::Sweep {
                 dir,
                 start,
-                mut current,
-            } => {
-                let start = if n == 1 { x.position_counts } else { start };
-                // The current vector's magnitude does not depend on the frame: over the
-                // check window it must reach half the reference, or a phase (or the
-                // motor, or the current sensing) is open. Checked early, before the
-                // PI has sat at its voltage limit for long.
-                let [a, b, c] = x.i_abc;
-                let ab = clarke(a, b, c);
-                if n > self.p.check.0 && n <= self.p.check.1 {
-                    current.add(libm::sqrtf(ab.alpha * ab.alpha + ab.beta * ab.beta));
-                }
-                if n == self.p.check.1 && current.value() < 0.4 * self.c.current_a {
-                    return self.fail(FaultCode::CommissioningCurrent);
-                }
-                self.phase = Phase::Sweep {
-                    dir,
-                    start,
-                    current,
-                };
-                if n >= self.p.sweep {
-                    // About one electrical turn in the sweep's direction (less the rotor's
-                    // initial snap of up to half a turn).
-                    // Backwards (reversed encoder) or hardly at all (no movement).
-                    let moved = dir * self.travel(x.position_counts, start);
-                    if moved < 0.25 * TAU {
-                        return self.fail(FaultCode::CommissioningEncoder);
-                    }
-                    self.next(Phase::Hold {
-                        dir,
-                        angle: CircularMean::default(),
-                    });
-                }
-                let theta = dir * TAU * n as f32 / self.p.sweep as f32;
-                self.align(theta, x)
-            }
-            Phase::Hold { dir, mut angle } => {
-                if n > self.p.settle {
-                    angle.add(x.theta_e_raw);
-                }
-                self.phase = Phase::Hold { dir, angle };
-                if n >= self.p.settle + self.p.average {
-                    let k = if dir > 0.0 { 0 } else { 1 };
-                    self.offsets[k] = angle;
-                    if dir > 0.0 {
-                        self.next(Phase::Sweep {
-                            dir: -1.0,
-                            start: 0,
-                            current: Mean::default(),
-                        });
-                    } else {
-                        let [a, b] = self.offsets;
-                        if angle_difference(a.value(), b.value()).abs() > HOLD_AGREEMENT_RAD {
-                            return self.fail(FaultCode::CommissioningEncoder);
-                        }
-                        let mut both = CircularMean::default();
-                        both.add_direction(&a);
-                        both.add_direction(&b);
-                        self.offset = crate::transforms::wrap_2pi(both.value());
-                        self.next(Phase::Level {
-                            high: false,
-                            u: Mean::default(),
-                            i: Mean::default(),
-                            u_q: Mean::default(),
-                        });
-                    }
-                }
-                self.align(0.0, x)
-            }
-            Phase::Level {
-                high,
-                mut u,
-                mut i,
-                mut u_q,
-            } => {
-                let i_ref = if high { 0.8 * i_max } else { 0.4 * i_max };
-                if n > self.p.settle {
-                    u.add(x.u_dq_prev.d);
-                    u_q.add(x.u_dq_prev.q);
-                    i.add(forced_dq(x).d);
-                }
-                self.phase = Phase::Level { high, u, i, u_q };
-                if n >= self.p.settle + self.p.average {
-                    let (u, i) = (u.value(), i.value());
-                    if (i - i_ref).abs() > 0.1 * i_ref {
-                        return self.fail(FaultCode::CommissioningCurrent);
-                    }
-                    if !high {
-                        self.levels[0] = (u, i);
-                        self.next(Phase::Level {
-                            high: true,
-                            u: Mean::default(),
-                            i: Mean::default(),
-                            u_q: Mean::default(),
-                        });
-                    } else {
-                        self.levels[1] = (u, i);
-                        self.u_hold = Dq {
-                            d: u,
-                            q: u_q.value(),
-                        };
-                        let (u1, i1) = self.levels[0];
-                        self.r_s = (u - u1) / (i - i1);
-                        if !self.plausible(self.r_s, 0) {
-                            return self.fail(FaultCode::CommissioningImplausible);
-                        }
-                        self.next(Commissioning::pulses(Axis::D));
-                    }
-                }
-                Action::Current {
-                    theta_e: 0.0,
-                    rotor_frame: false,
-                    i_ref: Dq {
-                        d: i_ref,
-                        q: self.damping(x, i_ref),
-                    },
-                }
-            }
+                current,
+            } => self.sweep_alignment(x, dir, start, current),
+            Phase::Hold { dir, angle } => self.hold_alignment(x, dir, angle),
+            Phase::Level { high, u, i, u_q } => self.measure_resistance(x, high, u, i, u_q),
             Phase::Pulses { .. } => self.pulse_step(x),
-            Phase::Accelerate { sign, w1, mut i } => {
-                let theta_e = x.theta_e_raw - self.offset;
-                let w = x.speed_rad_s;
-                let w1 = if n == self.p.accel_settle { w } else { w1 };
-                if n > self.p.accel_settle {
-                    i.add(self.encoder_dq(x).q);
-                }
-                self.phase = Phase::Accelerate { sign, w1, i };
-                let target = if sign > 0.0 { 1.0 } else { 0.3 } * self.c.spin_speed_rad_s;
-                if n > 2 * self.p.accel_settle && sign * (w - target) >= 0.0 {
-                    let dt = (n - self.p.accel_settle) as f32 * self.p.t;
-                    let k = if sign > 0.0 { 0 } else { 1 };
-                    self.alpha[k] = ((w - w1) / dt, i.value());
-                    if sign > 0.0 {
-                        self.next(Phase::Spin {
-                            u_q: Mean::default(),
-                            i_q: Mean::default(),
-                            i_d: Mean::default(),
-                            start: 0,
-                        });
-                    } else {
-                        self.next(Phase::Stop);
-                    }
-                } else if n >= self.p.timeout
-                    || (sign > 0.0 && w < -0.3 * self.c.spin_speed_rad_s)
-                    || (sign < 0.0 && w > 1.5 * self.c.spin_speed_rad_s)
-                {
-                    // No speed, or speed the wrong way round: the shaft does not follow.
+            Phase::Accelerate { sign, w1, i } => self.measure_acceleration(x, sign, w1, i),
+            Phase::Spin {
+                u_q,
+                i_q,
+                i_d,
+                start,
+            } => self.measure_flux(x, u_q, i_q, i_d, start),
+            Phase::Stop => self.stop_and_finish(x),
+        }
+    }
+
+    /// One period of an alignment sweep: the forced angle turns one electrical turn in `dir`;
+    /// checks for an open phase early and, at the end, that the encoder followed (step 1).
+    #[inline]
+    fn sweep_alignment(&mut self, x: &Input, dir: f32, start: i64, mut current: Mean) -> Action {
+        let n = self.n;
+        let start = if n == 1 { x.position_counts } else { start };
+        // The current vector's magnitude does not depend on the frame: over the
+        // check window it must reach half the reference, or a phase (or the
+        // motor, or the current sensing) is open. Checked early, before the
+        // PI has sat at its voltage limit for long.
+        let [a, b, c] = x.i_abc;
+        let ab = clarke(a, b, c);
+        if n > self.p.check.0 && n <= self.p.check.1 {
+            current.add(libm::sqrtf(ab.alpha * ab.alpha + ab.beta * ab.beta));
+        }
+        if n == self.p.check.1 && current.value() < 0.4 * self.c.current_a {
+            return self.fail(FaultCode::CommissioningCurrent);
+        }
+        self.phase = Phase::Sweep {
+            dir,
+            start,
+            current,
+        };
+        if n >= self.p.sweep {
+            // About one electrical turn in the sweep's direction (less the rotor's
+            // initial snap of up to half a turn).
+            // Backwards (reversed encoder) or hardly at all (no movement).
+            let moved = dir * self.travel(x.position_counts, start);
+            if moved < 0.25 * TAU {
+                return self.fail(FaultCode::CommissioningEncoder);
+            }
+            self.next(Phase::Hold {
+                dir,
+                angle: CircularMean::default(),
+            });
+        }
+        let theta = dir * TAU * n as f32 / self.p.sweep as f32;
+        self.align(theta, x)
+    }
+
+    /// One period of an alignment hold at θ_e = 0: averages the encoder's angle; after the
+    /// backward hold, checks the two holds agree and sets the encoder offset (step 1).
+    #[inline]
+    fn hold_alignment(&mut self, x: &Input, dir: f32, mut angle: CircularMean) -> Action {
+        let n = self.n;
+        if n > self.p.settle {
+            angle.add(x.theta_e_raw);
+        }
+        self.phase = Phase::Hold { dir, angle };
+        if n >= self.p.settle + self.p.average {
+            let k = if dir > 0.0 { 0 } else { 1 };
+            self.offsets[k] = angle;
+            if dir > 0.0 {
+                self.next(Phase::Sweep {
+                    dir: -1.0,
+                    start: 0,
+                    current: Mean::default(),
+                });
+            } else {
+                let [a, b] = self.offsets;
+                if angle_difference(a.value(), b.value()).abs() > HOLD_AGREEMENT_RAD {
                     return self.fail(FaultCode::CommissioningEncoder);
                 }
-                Action::Current {
-                    theta_e,
-                    rotor_frame: true,
-                    i_ref: Dq {
-                        d: 0.0,
-                        q: sign * self.c.spin_current_a,
-                    },
-                }
+                let mut both = CircularMean::default();
+                both.add_direction(&a);
+                both.add_direction(&b);
+                self.offset = crate::transforms::wrap_2pi(both.value());
+                self.next(Phase::Level {
+                    high: false,
+                    u: Mean::default(),
+                    i: Mean::default(),
+                    u_q: Mean::default(),
+                });
             }
-            Phase::Spin {
-                mut u_q,
-                mut i_q,
-                mut i_d,
-                start,
-            } => {
-                let theta_e = x.theta_e_raw - self.offset;
-                let start = if n == self.p.settle {
-                    x.position_counts
-                } else {
-                    start
+        }
+        self.align(0.0, x)
+    }
+
+    /// One period at a d-current level: averages the voltage and current; after the high
+    /// level, R_s from the two levels and the hold voltages for the pulses (step 2).
+    #[inline]
+    fn measure_resistance(
+        &mut self,
+        x: &Input,
+        high: bool,
+        mut u: Mean,
+        mut i: Mean,
+        mut u_q: Mean,
+    ) -> Action {
+        let i_max = self.c.current_a;
+        let n = self.n;
+        let i_ref = if high { 0.8 * i_max } else { 0.4 * i_max };
+        if n > self.p.settle {
+            u.add(x.u_dq_prev.d);
+            u_q.add(x.u_dq_prev.q);
+            i.add(forced_dq(x).d);
+        }
+        self.phase = Phase::Level { high, u, i, u_q };
+        if n >= self.p.settle + self.p.average {
+            let (u, i) = (u.value(), i.value());
+            if (i - i_ref).abs() > 0.1 * i_ref {
+                return self.fail(FaultCode::CommissioningCurrent);
+            }
+            if !high {
+                self.levels[0] = (u, i);
+                self.next(Phase::Level {
+                    high: true,
+                    u: Mean::default(),
+                    i: Mean::default(),
+                    u_q: Mean::default(),
+                });
+            } else {
+                self.levels[1] = (u, i);
+                self.u_hold = Dq {
+                    d: u,
+                    q: u_q.value(),
                 };
-                if n > self.p.settle {
-                    let i = self.encoder_dq(x);
-                    u_q.add(x.u_dq_prev.q);
-                    i_q.add(i.q);
-                    i_d.add(i.d);
+                let (u1, i1) = self.levels[0];
+                self.r_s = (u - u1) / (i - i1);
+                if !self.plausible(self.r_s, 0) {
+                    return self.fail(FaultCode::CommissioningImplausible);
                 }
-                self.phase = Phase::Spin {
-                    u_q,
-                    i_q,
-                    i_d,
-                    start,
-                };
-                if n >= self.p.settle + self.p.average {
-                    let w_e = self.travel(x.position_counts, start)
-                        / ((n - self.p.settle) as f32 * self.p.t);
-                    self.psi_f =
-                        (u_q.value() - self.r_s * i_q.value() - w_e * self.l[0] * i_d.value())
-                            / w_e;
-                    if !self.plausible(self.psi_f, 3) {
-                        return self.fail(FaultCode::CommissioningImplausible);
-                    }
-                    self.next(Phase::Accelerate {
-                        sign: -1.0,
-                        w1: 0.0,
-                        i: Mean::default(),
-                    });
-                }
-                Action::Speed {
-                    theta_e,
-                    rad_s: self.c.spin_speed_rad_s,
-                }
+                self.next(Commissioning::pulses(Axis::D));
             }
-            Phase::Stop => {
-                let theta_e = x.theta_e_raw - self.offset;
-                if n >= self.p.settle + self.p.average {
-                    return self.finish();
-                }
-                Action::Speed {
-                    theta_e,
-                    rad_s: 0.0,
-                }
+        }
+        Action::Current {
+            theta_e: 0.0,
+            rotor_frame: false,
+            i_ref: Dq {
+                d: i_ref,
+                q: self.damping(x, i_ref),
+            },
+        }
+    }
+
+    /// One period at constant q-current (`sign`): the acceleration and its mean current once
+    /// the target speed is reached, or a fault if the shaft does not follow (step 5).
+    #[inline]
+    fn measure_acceleration(&mut self, x: &Input, sign: f32, w1: f32, mut i: Mean) -> Action {
+        let n = self.n;
+        let theta_e = x.theta_e_raw - self.offset;
+        let w = x.speed_rad_s;
+        let w1 = if n == self.p.accel_settle { w } else { w1 };
+        if n > self.p.accel_settle {
+            i.add(self.encoder_dq(x).q);
+        }
+        self.phase = Phase::Accelerate { sign, w1, i };
+        let target = if sign > 0.0 { 1.0 } else { 0.3 } * self.c.spin_speed_rad_s;
+        if n > 2 * self.p.accel_settle && sign * (w - target) >= 0.0 {
+            let dt = (n - self.p.accel_settle) as f32 * self.p.t;
+            let k = if sign > 0.0 { 0 } else { 1 };
+            self.alpha[k] = ((w - w1) / dt, i.value());
+            if sign > 0.0 {
+                self.next(Phase::Spin {
+                    u_q: Mean::default(),
+                    i_q: Mean::default(),
+                    i_d: Mean::default(),
+                    start: 0,
+                });
+            } else {
+                self.next(Phase::Stop);
             }
+        } else if n >= self.p.timeout
+            || (sign > 0.0 && w < -0.3 * self.c.spin_speed_rad_s)
+            || (sign < 0.0 && w > 1.5 * self.c.spin_speed_rad_s)
+        {
+            // No speed, or speed the wrong way round: the shaft does not follow.
+            return self.fail(FaultCode::CommissioningEncoder);
+        }
+        Action::Current {
+            theta_e,
+            rotor_frame: true,
+            i_ref: Dq {
+                d: 0.0,
+                q: sign * self.c.spin_current_a,
+            },
+        }
+    }
+
+    /// One period of speed control at the spin speed: averages u_q, i_q, i_d and the
+    /// encoder's travel, then ψ_f (step 5).
+    #[inline]
+    fn measure_flux(
+        &mut self,
+        x: &Input,
+        mut u_q: Mean,
+        mut i_q: Mean,
+        mut i_d: Mean,
+        start: i64,
+    ) -> Action {
+        let n = self.n;
+        let theta_e = x.theta_e_raw - self.offset;
+        let start = if n == self.p.settle {
+            x.position_counts
+        } else {
+            start
+        };
+        if n > self.p.settle {
+            let i = self.encoder_dq(x);
+            u_q.add(x.u_dq_prev.q);
+            i_q.add(i.q);
+            i_d.add(i.d);
+        }
+        self.phase = Phase::Spin {
+            u_q,
+            i_q,
+            i_d,
+            start,
+        };
+        if n >= self.p.settle + self.p.average {
+            let w_e =
+                self.travel(x.position_counts, start) / ((n - self.p.settle) as f32 * self.p.t);
+            self.psi_f =
+                (u_q.value() - self.r_s * i_q.value() - w_e * self.l[0] * i_d.value()) / w_e;
+            if !self.plausible(self.psi_f, 3) {
+                return self.fail(FaultCode::CommissioningImplausible);
+            }
+            self.next(Phase::Accelerate {
+                sign: -1.0,
+                w1: 0.0,
+                i: Mean::default(),
+            });
+        }
+        Action::Speed {
+            theta_e,
+            rad_s: self.c.spin_speed_rad_s,
+        }
+    }
+
+    /// One period of speed control at standstill, then the result with its gains.
+    #[inline]
+    fn stop_and_finish(&mut self, x: &Input) -> Action {
+        let n = self.n;
+        let theta_e = x.theta_e_raw - self.offset;
+        if n >= self.p.settle + self.p.average {
+            return self.finish();
+        }
+        Action::Speed {
+            theta_e,
+            rad_s: 0.0,
         }
     }
 

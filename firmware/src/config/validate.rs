@@ -41,8 +41,29 @@ pub fn whole_ratio(fast: f32, slow: f32) -> Option<u32> {
 }
 
 impl Config {
-    /// Checks every field; the error names the first offending one.
+    /// Checks every field, part by part in a fixed order; the error names the first
+    /// offending one.
     pub fn validate(&self) -> Result<(), ConfigError> {
+        self.validate_rates()?;
+        self.validate_sensors()?;
+        self.validate_motor()?;
+        self.validate_current()?;
+        self.validate_speed()?;
+        self.validate_pressure()?;
+        self.validate_hydraulics()?;
+        self.validate_limits()?;
+        self.validate_calibration()?;
+        self.commissioning.validate(
+            self.limits.over_current_a,
+            self.current.voltage_limit_v,
+            self.speed.speed_limit_rad_s,
+            self.rates.pwm_hz,
+        )?;
+        self.compensation.validate()
+    }
+
+    /// The loop rates: PWM range, whole loop-rate ratios, pressure-loop margin, decimation.
+    fn validate_rates(&self) -> Result<(), ConfigError> {
         let r = &self.rates;
         if !(r.pwm_hz.is_finite() && (1_000.0..=100_000.0).contains(&r.pwm_hz)) {
             return Err(err("rates.pwm_hz", "must be within 1 kHz..=100 kHz"));
@@ -74,7 +95,12 @@ impl Config {
                 "must be within 1..=10000",
             ));
         }
+        Ok(())
+    }
 
+    /// The sensor scalings: scales and zeros, the shunt window, pressure wiring, encoder.
+    fn validate_sensors(&self) -> Result<(), ConfigError> {
+        let r = &self.rates;
         let s = &self.sensors;
         positive("sensors.current_a_per_lsb", s.current_a_per_lsb)?;
         if !(s.current_zero_lsb.is_finite() && (0.0..=4095.0).contains(&s.current_zero_lsb)) {
@@ -107,7 +133,11 @@ impl Config {
         if !s.encoder_offset_rad.is_finite() {
             return Err(err("sensors.encoder_offset_rad", "must be finite"));
         }
+        Ok(())
+    }
 
+    /// The motor's nameplate constants.
+    fn validate_motor(&self) -> Result<(), ConfigError> {
         let m = &self.motor;
         if !(1..=64).contains(&m.pole_pairs) {
             return Err(err("motor.pole_pairs", "must be within 1..=64"));
@@ -117,14 +147,23 @@ impl Config {
         positive("motor.q_inductance_h", m.q_inductance_h)?;
         non_negative("motor.flux_linkage_wb", m.flux_linkage_wb)?;
         positive("motor.dc_link_nominal_v", m.dc_link_nominal_v)?;
+        Ok(())
+    }
 
+    /// The current loop's gains and voltage limit.
+    fn validate_current(&self) -> Result<(), ConfigError> {
         let c = &self.current;
         positive("current.kp_d", c.kp_d)?;
         non_negative("current.ki_d", c.ki_d)?;
         positive("current.kp_q", c.kp_q)?;
         non_negative("current.ki_q", c.ki_q)?;
         positive("current.voltage_limit_v", c.voltage_limit_v)?;
+        Ok(())
+    }
 
+    /// The speed loop's gains, limits and speed observer.
+    fn validate_speed(&self) -> Result<(), ConfigError> {
+        let r = &self.rates;
         let sp = &self.speed;
         positive("speed.kp", sp.kp)?;
         non_negative("speed.ki", sp.ki)?;
@@ -141,7 +180,11 @@ impl Config {
                 "must be at most 0.25 * rates.pwm_hz (omega_n * T <= 0.25)",
             ));
         }
+        Ok(())
+    }
 
+    /// The pressure loop's bandwidth, filter, ramp and setpoint range.
+    fn validate_pressure(&self) -> Result<(), ConfigError> {
         let p = &self.pressure;
         positive("pressure.bandwidth_rad_s", p.bandwidth_rad_s)?;
         if !(p.integral_corner_ratio.is_finite() && (0.0..=1.0).contains(&p.integral_corner_ratio))
@@ -167,7 +210,11 @@ impl Config {
                 "must be below pressure.setpoint_max_pa",
             ));
         }
+        Ok(())
+    }
 
+    /// The hydraulics' constants.
+    fn validate_hydraulics(&self) -> Result<(), ConfigError> {
         let h = &self.hydraulics;
         positive(
             "hydraulics.pump_displacement_m3_per_rev",
@@ -184,7 +231,15 @@ impl Config {
             ));
         }
         non_negative("hydraulics.leakage_m3_per_s_pa", h.leakage_m3_per_s_pa)?;
+        Ok(())
+    }
 
+    /// The fault limits, each against the range it must exceed or fit in.
+    fn validate_limits(&self) -> Result<(), ConfigError> {
+        let r = &self.rates;
+        let s = &self.sensors;
+        let sp = &self.speed;
+        let p = &self.pressure;
         let l = &self.limits;
         positive("limits.over_current_a", l.over_current_a)?;
         if l.over_current_a <= sp.iq_limit_a {
@@ -253,7 +308,13 @@ impl Config {
         if l.stall_time_s > 3600.0 {
             return Err(err("limits.stall_time_s", "must be at most 3600 s"));
         }
+        Ok(())
+    }
 
+    /// The calibration's times and currents.
+    fn validate_calibration(&self) -> Result<(), ConfigError> {
+        let r = &self.rates;
+        let l = &self.limits;
         let k = &self.calibration;
         positive("calibration.offset_time_s", k.offset_time_s)?;
         if k.offset_time_s * r.pwm_hz < 16.0 || k.offset_time_s > 10.0 {
@@ -281,12 +342,6 @@ impl Config {
         if k.alignment_time_s > 60.0 {
             return Err(err("calibration.alignment_time_s", "must be at most 60 s"));
         }
-        self.commissioning.validate(
-            l.over_current_a,
-            c.voltage_limit_v,
-            sp.speed_limit_rad_s,
-            r.pwm_hz,
-        )?;
-        self.compensation.validate()
+        Ok(())
     }
 }
