@@ -205,10 +205,50 @@ fn phase(rng: &mut Rng) -> Phase {
     Phase::ALL[rng.below(3)]
 }
 
+/// A drawn fault: its injection, how long it lasts before its repair, and its description.
+type Drawn = (Injection, Option<f64>, String);
+
 /// Draws a fault of `class`.
 pub fn draw(class: Class, rng: &mut Rng) -> Fault {
-    let node = NodeId::new(DRIVE_NODE).unwrap_or_else(|_| unreachable!("node 1 is valid"));
     let (injection, lasts_s, description) = match class {
+        Class::PhaseOpen | Class::PhaseToPhaseShort | Class::PhaseToRailShort => {
+            winding_fault(class, rng)
+        }
+        Class::DcLinkSag | Class::DcLinkSurge | Class::SupplyRipple => supply_fault(class, rng),
+        Class::EncoderLostCounts
+        | Class::EncoderNoiseBurst
+        | Class::EncoderStuck
+        | Class::EncoderLostIndex
+        | Class::EncoderReversed => encoder_fault(class, rng),
+        Class::PressureOpenWire
+        | Class::PressureShort
+        | Class::PressureStuck
+        | Class::PressureDrift
+        | Class::PressureNoiseBurst => pressure_sensor_fault(class, rng),
+        Class::CurrentStuck | Class::CurrentGainError | Class::CurrentSaturation => {
+            current_sensor_fault(class, rng)
+        }
+        Class::ReliefStuckClosed | Class::BurstLine | Class::BlockedPumpPort => {
+            hydraulic_fault(class, rng)
+        }
+        Class::CanFlood
+        | Class::CanGarbage
+        | Class::OutOfRangeSetpoints
+        | Class::ParameterBounds
+        | Class::CommandTimeout
+        | Class::ControlOverrun => command_fault(class, rng),
+    };
+    Fault {
+        class,
+        injection,
+        lasts_s,
+        description,
+    }
+}
+
+/// Draws `class`, an open phase or a short from a phase.
+fn winding_fault(class: Class, rng: &mut Rng) -> Drawn {
+    match class {
         Class::PhaseOpen => {
             let p = phase(rng);
             let f = PlantFaults {
@@ -217,7 +257,7 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
             };
             (plant(f), None, format!("phase {p:?}"))
         }
-        Class::PhaseToPhaseShort | Class::PhaseToRailShort => {
+        _ => {
             let from = phase(rng);
             let path = if class == Class::PhaseToPhaseShort {
                 let to = if rng.below(2) == 0 {
@@ -252,6 +292,12 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 format!("{path:?}, {r:.3} Ω, {:.1} µH", l * 1e6),
             )
         }
+    }
+}
+
+/// Draws `class`, a DC link that sags, surges or ripples.
+fn supply_fault(class: Class, rng: &mut Rng) -> Drawn {
+    match class {
         Class::DcLinkSag | Class::DcLinkSurge => {
             let to_v = if class == Class::DcLinkSag {
                 rng.uniform(100.0, 260.0)
@@ -272,7 +318,7 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 format!("to {to_v:.0} V, τ {:.1} ms", tau * 1e3),
             )
         }
-        Class::SupplyRipple => {
+        _ => {
             let a = rng.uniform(10.0, 120.0);
             let hz = if rng.below(2) == 0 { 100.0 } else { 300.0 };
             let f = PlantFaults {
@@ -284,6 +330,12 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
             };
             (plant(f), None, format!("{a:.0} V at {hz:.0} Hz"))
         }
+    }
+}
+
+/// Draws `class`, an encoder fault.
+fn encoder_fault(class: Class, rng: &mut Rng) -> Drawn {
+    match class {
         Class::EncoderLostCounts => {
             let n = rng.uniform(1.0, 400.0) as i32 * if rng.below(2) == 0 { 1 } else { -1 };
             (
@@ -307,7 +359,7 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 format!("{rms:.1} counts rms for {:.1} ms", d * 1e3),
             )
         }
-        Class::EncoderStuck | Class::EncoderLostIndex | Class::EncoderReversed => {
+        _ => {
             let e = match class {
                 Class::EncoderStuck => EncoderFault::Stuck,
                 Class::EncoderLostIndex => EncoderFault::LostIndex,
@@ -322,6 +374,12 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 String::new(),
             )
         }
+    }
+}
+
+/// Draws `class`, a pressure transducer fault.
+fn pressure_sensor_fault(class: Class, rng: &mut Rng) -> Drawn {
+    match class {
         Class::PressureOpenWire | Class::PressureShort | Class::PressureStuck => {
             let p = match class {
                 Class::PressureOpenWire => PressureFault::OpenWire,
@@ -348,7 +406,7 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 format!("{:+.2} MPa/s", rate / 1e6),
             )
         }
-        Class::PressureNoiseBurst => {
+        _ => {
             let rms = rng.log_uniform(10e3, 10e6);
             let d = rng.uniform(1e-3, 50e-3);
             (
@@ -360,37 +418,45 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 format!("{:.3} MPa rms for {:.1} ms", rms / 1e6, d * 1e3),
             )
         }
-        Class::CurrentStuck | Class::CurrentGainError | Class::CurrentSaturation => {
-            let p = phase(rng);
-            let (c, text) = match class {
-                Class::CurrentStuck => (CurrentFault::Stuck { phase: p }, format!("{p:?}")),
-                Class::CurrentGainError => {
-                    let g = rng.uniform(0.3, 1.7);
-                    (
-                        CurrentFault::GainError { phase: p, gain: g },
-                        format!("{p:?} gain {g:.2}"),
-                    )
-                }
-                _ => {
-                    let l = rng.uniform(1.0, 40.0);
-                    (
-                        CurrentFault::Saturation {
-                            phase: p,
-                            limit_a: l,
-                        },
-                        format!("{p:?} at ±{l:.1} A"),
-                    )
-                }
-            };
+    }
+}
+
+/// Draws `class`, a phase-current sensor fault.
+fn current_sensor_fault(class: Class, rng: &mut Rng) -> Drawn {
+    let p = phase(rng);
+    let (c, text) = match class {
+        Class::CurrentStuck => (CurrentFault::Stuck { phase: p }, format!("{p:?}")),
+        Class::CurrentGainError => {
+            let g = rng.uniform(0.3, 1.7);
             (
-                sensor(SensorFaults {
-                    current: Some(c),
-                    ..SensorFaults::default()
-                }),
-                None,
-                text,
+                CurrentFault::GainError { phase: p, gain: g },
+                format!("{p:?} gain {g:.2}"),
             )
         }
+        _ => {
+            let l = rng.uniform(1.0, 40.0);
+            (
+                CurrentFault::Saturation {
+                    phase: p,
+                    limit_a: l,
+                },
+                format!("{p:?} at ±{l:.1} A"),
+            )
+        }
+    };
+    (
+        sensor(SensorFaults {
+            current: Some(c),
+            ..SensorFaults::default()
+        }),
+        None,
+        text,
+    )
+}
+
+/// Draws `class`, a hydraulic fault.
+fn hydraulic_fault(class: Class, rng: &mut Rng) -> Drawn {
+    match class {
         Class::ReliefStuckClosed => (
             plant(PlantFaults {
                 relief_stuck_closed: true,
@@ -410,7 +476,7 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 format!("{:.3} mm²", a * 1e6),
             )
         }
-        Class::BlockedPumpPort => (
+        _ => (
             plant(PlantFaults {
                 pump_port_blocked: true,
                 ..PlantFaults::default()
@@ -418,6 +484,13 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
             None,
             String::new(),
         ),
+    }
+}
+
+/// Draws `class`, a fault on the CAN bus or in the control task.
+fn command_fault(class: Class, rng: &mut Rng) -> Drawn {
+    let node = NodeId::new(DRIVE_NODE).unwrap_or_else(|_| unreachable!("node 1 is valid"));
+    match class {
         Class::CanFlood => {
             // Any identifier: below the PC's commands it starves them, above it does not.
             let id = rng.below(0x800) as u16;
@@ -477,13 +550,7 @@ pub fn draw(class: Class, rng: &mut Rng) -> Fault {
                 format!("silent {:.0} ms", d * 1e3),
             )
         }
-        Class::ControlOverrun => (Injection::Overrun, Some(0.0), String::new()),
-    };
-    Fault {
-        class,
-        injection,
-        lasts_s,
-        description,
+        _ => (Injection::Overrun, Some(0.0), String::new()),
     }
 }
 
