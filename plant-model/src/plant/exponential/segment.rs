@@ -382,9 +382,9 @@ impl Plant {
         }
     }
 
-    /// A free piston's speed and stroke at the segment's end: its speed from the block's end `y1`, its stroke by
-    /// the Hermite rule on the speed with the acceleration A/m·(p_A − p_B) − B_p/m·v + the
-    /// forcing at both ends.
+    /// A free piston's speed and stroke at the segment's end: its speed from the block's end
+    /// `y1`, its stroke by the Hermite rule on the speed with the acceleration
+    /// A/m·(p_A − p_B) − B_p/m·v + the forcing at both ends.
     #[inline(always)]
     fn piston_stroke(
         &self,
@@ -403,8 +403,9 @@ impl Plant {
         )
     }
 
-    /// The fill accumulator's oil and gas pressure at the segment's end: its oil by the extrapolated inflow's
-    /// integral, its gas along its polytropic law p_1 = p_0·(1 − ΔV/V_g)^(−n).
+    /// The fill accumulator's oil and gas pressure at the segment's end: its oil by the
+    /// extrapolated inflow's integral, its gas along its polytropic law
+    /// p_1 = p_0·(1 − ΔV/V_g)^(−n).
     #[inline(always)]
     fn fill_gas(&self, x0: &Vector, g0: &Rates, poly: &Poly, span: &Span) -> (f64, f64) {
         let (g1, g2) = (&poly.g1, &poly.g2);
