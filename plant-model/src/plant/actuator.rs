@@ -106,20 +106,23 @@ impl Plant {
     /// by `seed`.
     pub fn new(rig: &Rig, init: &InitialConditions, seed: u64) -> Result<Plant, RigError> {
         rig.validate()?;
-        for (name, v) in [
-            ("initial.p_a_pa", init.p_a_pa),
-            ("initial.p_b_pa", init.p_b_pa),
-            ("initial.x_m", init.x_m),
-            ("initial.omega_rad_s", init.omega_rad_s),
-            ("initial.theta_m_rad", init.theta_m_rad),
-        ] {
-            if !v.is_finite() {
-                return Err(RigError::new(name, "must be a finite number"));
-            }
-        }
-        if libm::fabs(init.x_m) > rig.cylinder.half_stroke_m {
-            return Err(RigError::new("initial.x_m", "must lie within the stroke"));
-        }
+        check_initial_conditions(rig, init)?;
+        let mut plant = Plant::assemble(rig, init, seed);
+        plant.angle = plant.angle_terms(init.theta_m_rad);
+        plant.exp = History::new(
+            &plant.motor,
+            &plant.inverter,
+            [plant.absorber.gas.exponent, plant.fill_gas.exponent],
+        );
+        plant.stored0_j = plant.stored_energy_j(&plant.x);
+        Ok(plant)
+    }
+
+    /// The plant's components built from `rig` with the state of `init` and sensor noise
+    /// seeded by `seed`; what depends on the assembled plant (the angle terms, the
+    /// exponential integrator's blocks and the stored energy at the start) is left to
+    /// [`Plant::new`] to fill in.
+    fn assemble(rig: &Rig, init: &InitialConditions, seed: u64) -> Plant {
         let absorber = Absorber::new(&rig.absorber);
         let fill_gas = GasCharge {
             shell_volume_m3: rig.fill.shell_volume_m3,
@@ -127,32 +130,8 @@ impl Plant {
             exponent: rig.fill.polytropic_exponent,
         };
         let cylinder = Cylinder::new(&rig.cylinder);
-        let mut x = [0.0; ix::N];
-        x[ix::THETA] = init.theta_m_rad;
-        x[ix::OMEGA] = init.omega_rad_s;
-        x[ix::PA] = init.p_a_pa;
-        x[ix::PB] = init.p_b_pa;
-        x[ix::X] = if cylinder.blocked { 0.0 } else { init.x_m };
-        x[ix::ABS_OIL] = if absorber.enabled {
-            absorber.gas.oil_volume_m3(init.p_a_pa)
-        } else {
-            0.0
-        };
-        x[ix::FILL_OIL] = fill_gas.oil_volume_m3(rig.fill.pressure_pa);
-        x[ix::FILL_PGAS] = rig.fill.pressure_pa + ATMOSPHERE_PA;
-        x[ix::ABS_PGAS] = absorber.gas.pressure_pa(x[ix::ABS_OIL]) + ATMOSPHERE_PA;
-        x[ix::P_SENSOR] = init.p_a_pa;
-        x[ix::PP] = init.p_a_pa;
-        let slip0 = |v: f64| {
-            if v == 0.0 {
-                Slip::Stuck
-            } else if v < 0.0 {
-                Slip::Sliding(-1.0)
-            } else {
-                Slip::Sliding(1.0)
-            }
-        };
-        let mut plant = Plant {
+        let x = initial_state(rig, init, &cylinder, &absorber, &fill_gas);
+        Plant {
             motor: Motor::new(&rig.motor),
             pole_pairs: rig.motor.pole_pairs,
             inverter: Inverter::new(&rig.inverter),
@@ -172,20 +151,14 @@ impl Plant {
                 cracking_pa: rig.fill.check_cracking_pa,
                 conductance_m3_s_pa: rig.fill.check_conductance_m3_s_pa,
             },
-            relief: Valve {
-                cracking_pa: rig.fill.relief_cracking_pa,
-                conductance_m3_s_pa: rig.fill.relief_conductance_m3_s_pa,
-            },
-            relief_a: Valve {
-                cracking_pa: rig.fill.relief_cracking_pa,
-                conductance_m3_s_pa: rig.fill.relief_conductance_m3_s_pa,
-            },
+            relief: relief_valve(rig),
+            relief_a: relief_valve(rig),
             sensor_lag_s: rig.sensors.pressure.lag_time_constant_s,
             sensors: Sensors::new(&rig.sensors, rig.motor.pole_pairs, seed),
             max_step_s: rig.integration.max_step_s,
             x,
             discrete: Discrete {
-                shaft: slip0(init.omega_rad_s),
+                shaft: initial_slip(init.omega_rad_s),
                 piston: Slip::Stuck,
                 extinguished: true,
             },
@@ -194,21 +167,7 @@ impl Plant {
             stored0_j: 0.0,
             last_inputs: Inputs::duties([0.5; 3], false),
             rotor: RotorPhasor::at(init.theta_m_rad),
-            angle: AngleTerms {
-                theta: f64::NAN,
-                rot_m: Phasor { cos: 1.0, sin: 0.0 },
-                rot_e: Phasor { cos: 1.0, sin: 0.0 },
-                flux: MagnetFlux {
-                    d_wb: 0.0,
-                    q_wb: 0.0,
-                    d_slope_wb: 0.0,
-                    q_slope_wb: 0.0,
-                    d_curvature_wb: 0.0,
-                    q_curvature_wb: 0.0,
-                },
-                t_cog: 0.0,
-                factor: 1.0,
-            },
+            angle: unset_angle_terms(),
             faulted: false,
             faults: PlantFaults::default(),
             dc_link: DcLink::new(rig.inverter.u_dc_v),
@@ -218,15 +177,7 @@ impl Plant {
             integrator: Integrator::default(),
             exp: History::default(),
             lag_filter: (f64::NAN, 0.0, 0.0),
-        };
-        plant.angle = plant.angle_terms(init.theta_m_rad);
-        plant.exp = History::new(
-            &plant.motor,
-            &plant.inverter,
-            [plant.absorber.gas.exponent, plant.fill_gas.exponent],
-        );
-        plant.stored0_j = plant.stored_energy_j(&plant.x);
-        Ok(plant)
+        }
     }
 
     /// Turns the shaft's angle by `delta_rad` without touching its speed or any other state:
@@ -275,5 +226,94 @@ impl Plant {
     /// The absorber model of this plant (for its natural frequency and damping).
     pub fn absorber(&self) -> &Absorber {
         &self.absorber
+    }
+}
+
+/// Checks that the initial conditions `init` are finite and put the piston within the
+/// stroke of `rig`.
+fn check_initial_conditions(rig: &Rig, init: &InitialConditions) -> Result<(), RigError> {
+    for (name, v) in [
+        ("initial.p_a_pa", init.p_a_pa),
+        ("initial.p_b_pa", init.p_b_pa),
+        ("initial.x_m", init.x_m),
+        ("initial.omega_rad_s", init.omega_rad_s),
+        ("initial.theta_m_rad", init.theta_m_rad),
+    ] {
+        if !v.is_finite() {
+            return Err(RigError::new(name, "must be a finite number"));
+        }
+    }
+    if libm::fabs(init.x_m) > rig.cylinder.half_stroke_m {
+        return Err(RigError::new("initial.x_m", "must lie within the stroke"));
+    }
+    Ok(())
+}
+
+/// The continuous state at the start from `init`: the piston centred if blocked, the
+/// absorber in equilibrium with port A, the fill accumulator at the rig's fill pressure,
+/// the pump's manifold and the pressure transducer at port A's.
+fn initial_state(
+    rig: &Rig,
+    init: &InitialConditions,
+    cylinder: &Cylinder,
+    absorber: &Absorber,
+    fill_gas: &GasCharge,
+) -> Vector {
+    let mut x = [0.0; ix::N];
+    x[ix::THETA] = init.theta_m_rad;
+    x[ix::OMEGA] = init.omega_rad_s;
+    x[ix::PA] = init.p_a_pa;
+    x[ix::PB] = init.p_b_pa;
+    x[ix::X] = if cylinder.blocked { 0.0 } else { init.x_m };
+    x[ix::ABS_OIL] = if absorber.enabled {
+        absorber.gas.oil_volume_m3(init.p_a_pa)
+    } else {
+        0.0
+    };
+    x[ix::FILL_OIL] = fill_gas.oil_volume_m3(rig.fill.pressure_pa);
+    x[ix::FILL_PGAS] = rig.fill.pressure_pa + ATMOSPHERE_PA;
+    x[ix::ABS_PGAS] = absorber.gas.pressure_pa(x[ix::ABS_OIL]) + ATMOSPHERE_PA;
+    x[ix::P_SENSOR] = init.p_a_pa;
+    x[ix::PP] = init.p_a_pa;
+    x
+}
+
+/// The shaft's friction state at the start at speed `omega`: stuck at rest, else sliding
+/// in its direction.
+fn initial_slip(omega: f64) -> Slip {
+    if omega == 0.0 {
+        Slip::Stuck
+    } else if omega < 0.0 {
+        Slip::Sliding(-1.0)
+    } else {
+        Slip::Sliding(1.0)
+    }
+}
+
+/// A relief valve of `rig`'s (port B's, and port A's as built).
+fn relief_valve(rig: &Rig) -> Valve {
+    Valve {
+        cracking_pa: rig.fill.relief_cracking_pa,
+        conductance_m3_s_pa: rig.fill.relief_conductance_m3_s_pa,
+    }
+}
+
+/// The angle terms before the shaft's are computed: `theta` NaN matches no angle, so that
+/// [`Plant::new`]'s first evaluation computes them rather than reusing these.
+fn unset_angle_terms() -> AngleTerms {
+    AngleTerms {
+        theta: f64::NAN,
+        rot_m: Phasor { cos: 1.0, sin: 0.0 },
+        rot_e: Phasor { cos: 1.0, sin: 0.0 },
+        flux: MagnetFlux {
+            d_wb: 0.0,
+            q_wb: 0.0,
+            d_slope_wb: 0.0,
+            q_slope_wb: 0.0,
+            d_curvature_wb: 0.0,
+            q_curvature_wb: 0.0,
+        },
+        t_cog: 0.0,
+        factor: 1.0,
     }
 }

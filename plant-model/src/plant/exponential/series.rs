@@ -223,19 +223,30 @@ impl Terms {
         tau: f64,
         k: usize,
     ) -> bool {
-        let a = &w.a;
-        let (cd, cq) = (w.coupling[0], w.coupling[1]);
-        let (ld, lq) = (w.inv_l[0], w.inv_l[1]);
-        let w0 = s.omega_e;
-        let [o1, o2, o3] = self.o;
-        let [e0, e1, e2] = self.e;
-        let [z, z1, z2, z3] = self.z;
-        let [u, u1, u2, u3] = self.u;
-        let [wk, wk1, wk2] = self.wk;
         let c = tau * INV[k];
-        // The forcing M·W_k + Σ ŵ_{k−m}·Ê_m (nothing of the back-EMF past order 5: ŵ ends
-        // at order 3, Ê at 2).
-        let (fd, fq) = match K {
+        let (fd, fq) = self.forcing::<K>(w, k);
+        let (rd, rq) = self.coupled::<TURNING, K>(w);
+        let zn = [c * (rd + fd), c * (rq + fq)];
+        let un = self.turned_voltage::<K>(s.omega_e, c);
+        self.o = self.speed_coefficients::<K>(s, tau, zn);
+        self.shift::<K>(zn, un);
+        self.add_to_sums(zn, un);
+        if K == 0 {
+            // The forcing's first term sets the scale of the change over the step.
+            self.tol[0] = current_tolerance(s, zn);
+        }
+        self.converged::<K>(zn, un)
+    }
+
+    /// The forcing M·W_k + Σ ŵ_{k−m}·Ê_m of order `k` (nothing of the back-EMF past order
+    /// 5: ŵ ends at order 3, Ê at 2).
+    #[inline(always)]
+    fn forcing<const K: usize>(&self, w: &Winding, k: usize) -> (f64, f64) {
+        let (ld, lq) = (w.inv_l[0], w.inv_l[1]);
+        let [e0, e1, e2] = self.e;
+        let u = self.u[0];
+        let [wk, wk1, wk2] = self.wk;
+        match K {
             0 => (ld * u[0] + wk * e0[0], lq * u[1] + wk * e0[1]),
             1 => (
                 ld * u[0] + wk * e0[0] + wk1 * e1[0],
@@ -246,8 +257,16 @@ impl Terms {
                 lq * u[1] + wk * e0[1] + wk1 * e1[1] + wk2 * e2[1],
             ),
             _ => (ld * u[0], lq * u[1]),
-        };
-        // A·Z_k and the speed's change: ŵ_j·C·Z_{k−j} (and τ·a1·Z_{k−1}).
+        }
+    }
+
+    /// A·Z_k and the speed's change ŵ_j·C·Z_{k−j} (and τ·a1·Z_{k−1} when `TURNING`).
+    #[inline(always)]
+    fn coupled<const TURNING: bool, const K: usize>(&self, w: &Winding) -> (f64, f64) {
+        let a = &w.a;
+        let (cd, cq) = (w.coupling[0], w.coupling[1]);
+        let [o1, o2, o3] = self.o;
+        let [z, z1, z2, z3] = self.z;
         let (mut rd, mut rq) = (
             a[0][0] * z[0] + a[0][1] * z[1],
             a[1][0] * z[0] + a[1][1] * z[1],
@@ -270,8 +289,15 @@ impl Terms {
                 rq = rq + b[1][0] * z1[0] + b[1][1] * z1[1];
             }
         }
-        let zn = [c * (rd + fd), c * (rq + fq)];
-        // The voltage turning with the rotor: ω_e0·J·W_k + ŵ_j·J·W_{k−j}.
+        (rd, rq)
+    }
+
+    /// The voltage's next term W_{k+1} = c·(ω_e0·J·W_k + ŵ_j·J·W_{k−j}), turning with the
+    /// rotor at `w0`, with `c` = τ/(k+1).
+    #[inline(always)]
+    fn turned_voltage<const K: usize>(&self, w0: f64, c: f64) -> [f64; 2] {
+        let [o1, o2, o3] = self.o;
+        let [u, u1, u2, u3] = self.u;
         let (vd, vq) = match K {
             0 => (w0 * u[1], w0 * u[0]),
             1 => (w0 * u[1] + o1 * u1[1], w0 * u[0] + o1 * u1[0]),
@@ -284,14 +310,36 @@ impl Terms {
                 w0 * u[0] + o1 * u1[0] + o2 * u2[0] + o3 * u3[0],
             ),
         };
-        let un = [c * vd, -c * vq];
-        // (k+2)·Ω_{k+2} = g·Y_{k+1} + load_k: ŵ_{k+2} = τ/(k+2)·(g·Z_{k+1} + load_k·τ^{k+1}).
+        [c * vd, -c * vq]
+    }
+
+    /// The speed's scaled coefficients with the one the new current term `zn` sets:
+    /// (k+2)·Ω_{k+2} = g·Y_{k+1} + load_k, ŵ_{k+2} = τ/(k+2)·(g·Z_{k+1} + load_k·τ^{k+1})
+    /// for the first two orders; unchanged after them.
+    #[inline(always)]
+    fn speed_coefficients<const K: usize>(
+        &self,
+        s: &WindingStart,
+        tau: f64,
+        zn: [f64; 2],
+    ) -> [f64; 3] {
         let g = s.accel_gain;
+        let mut o = self.o;
         if K == 0 {
-            self.o[1] = 0.5 * tau * (g[0] * zn[0] + g[1] * zn[1] + s.accel_load[0] * tau);
+            o[1] = 0.5 * tau * (g[0] * zn[0] + g[1] * zn[1] + s.accel_load[0] * tau);
         } else if K == 1 {
-            self.o[2] = tau / 3.0 * (g[0] * zn[0] + g[1] * zn[1] + s.accel_load[1] * tau * tau);
+            o[2] = tau / 3.0 * (g[0] * zn[0] + g[1] * zn[1] + s.accel_load[1] * tau * tau);
         }
+        o
+    }
+
+    /// Moves the last terms down by one order with `zn` and `un` the newest, and the speed's
+    /// coefficient ŵ_{k+1} in.
+    #[inline(always)]
+    fn shift<const K: usize>(&mut self, zn: [f64; 2], un: [f64; 2]) {
+        let [z, z1, z2, _] = self.z;
+        let [u, u1, u2, _] = self.u;
+        let [wk, wk1, _] = self.wk;
         self.z = [zn, z, z1, z2];
         self.u = [un, u, u1, u2];
         self.wk = [
@@ -304,6 +352,11 @@ impl Terms {
             wk,
             wk1,
         ];
+    }
+
+    /// Adds the terms `zn` and `un` to the sums at τ, and at τ/2 with the next power of ½.
+    #[inline(always)]
+    fn add_to_sums(&mut self, zn: [f64; 2], un: [f64; 2]) {
         self.half *= 0.5;
         let half = self.half;
         self.end[0] += zn[0];
@@ -314,19 +367,27 @@ impl Terms {
         self.u_end[1] += un[1];
         self.u_mid[0] += half * un[0];
         self.u_mid[1] += half * un[1];
-        if K == 0 {
-            // The forcing's first term sets the scale of the change over the step.
-            let scale_i = libm::fabs(s.i[0]) + libm::fabs(s.i[1]);
-            self.tol[0] = SERIES_TOLERANCE * (scale_i + libm::fabs(zn[0]) + libm::fabs(zn[1]));
-        }
-        // Two successive terms below the tolerance (one small term can be a forcing's zero
-        // crossing that the next order revives), past the speed's orders.
+    }
+
+    /// Whether the series has converged with the terms `zn` and `un`: two successive terms
+    /// below the tolerance (one small term can be a forcing's zero crossing that the next
+    /// order revives), past the speed's orders.
+    #[inline(always)]
+    fn converged<const K: usize>(&mut self, zn: [f64; 2], un: [f64; 2]) -> bool {
         let small = libm::fabs(zn[0]) + libm::fabs(zn[1]) <= self.tol[0]
             && libm::fabs(un[0]) + libm::fabs(un[1]) <= self.tol[1];
         let done = K >= 3 && small && self.small_before;
         self.small_before = small;
         done
     }
+}
+
+/// What a small term of the currents is, from the start's currents and the first term
+/// `zn` of the series.
+#[inline(always)]
+fn current_tolerance(s: &WindingStart, zn: [f64; 2]) -> f64 {
+    let scale_i = libm::fabs(s.i[0]) + libm::fabs(s.i[1]);
+    SERIES_TOLERANCE * (scale_i + libm::fabs(zn[0]) + libm::fabs(zn[1]))
 }
 
 #[cfg(test)]
