@@ -2,7 +2,7 @@
 //! protocol's wire scalings, the live-parameter commands multiplexed by the parameter id,
 //! the step test multiplexed by the loop, and the compensation table's load frames.
 
-use super::signal::{ascii, signal, Kind, Message, Mux, Sender};
+use super::signal::{ascii, signal, Kind, Message, Mux, Sender, Signal};
 use super::values::{loop_choices, mode_choices, parameter_choices, parameter_values, words};
 use firmware::can_protocol::{Function, SETPOINT_PA_PER_LSB, SETPOINT_RAD_S_PER_LSB};
 use firmware::step_test::StepLoop;
@@ -62,33 +62,11 @@ pub(super) fn command(f: Function) -> Message {
             "store the live parameters in flash (drive disabled only)",
             Vec::new(),
         ),
-        Function::StepTest => {
-            let mut s = vec![u8s("Loop")
-                .mux(Mux::Switch)
-                .choices(loop_choices())
-                .about("the stepped loop")];
-            s.extend(StepLoop::ALL.iter().map(|l| {
-                signal(
-                    &format!("Amplitude_{}", words(&format!("{l:?}"))),
-                    1,
-                    32,
-                    Kind::Float,
-                )
-                .unit(step_unit(*l))
-                .mux(Mux::Case(l.code()))
-                .about("step added to the present reference")
-            }));
-            s.push(
-                signal("Duration", 5, 16, Kind::Unsigned)
-                    .scaled(1e-3, "s")
-                    .about("how long the step is held (ms on the wire)"),
-            );
-            (
-                "StepTest",
-                "step one loop's reference with telemetry at full rate",
-                s,
-            )
-        }
+        Function::StepTest => (
+            "StepTest",
+            "step one loop's reference with telemetry at full rate",
+            step_test_signals(),
+        ),
         Function::Commission => (
             "Commission",
             "run the commissioning sequence (motor identification) in Calibrating",
@@ -99,15 +77,7 @@ pub(super) fn command(f: Function) -> Message {
             "one bin of the torque feed-forward table, in order from 0 after the header \
              (bin 65535: bytes 2-4 the three channels' LSB exponents as i8, byte 5 zero, \
              bytes 6-7 the bin count)",
-            vec![
-                signal("Bin", 0, 16, Kind::Unsigned).about("bin index; 65535 the header"),
-                signal("Raw0", 2, 16, Kind::Signed)
-                    .about("constant channel, LSB 2^-e0 A (header: exponents e0, e1)"),
-                signal("Raw1", 4, 16, Kind::Signed)
-                    .about("per-pressure channel, LSB 2^-e1 A/Pa (header: exponent e2)"),
-                signal("Raw2", 6, 16, Kind::Signed)
-                    .about("per-current channel, LSB 2^-e2 A/A (header: bin count)"),
-            ],
+            compensation_bin_signals(),
         ),
         Function::CompensationCommit => (
             "CompensationCommit",
@@ -136,4 +106,44 @@ pub(super) fn command(f: Function) -> Message {
         comment: ascii(comment),
         signals,
     }
+}
+
+/// The step test's signals, multiplexed by the stepped loop: each loop's amplitude in its
+/// own unit, then the step's duration.
+fn step_test_signals() -> Vec<Signal> {
+    let mut s = vec![signal("Loop", 0, 8, Kind::Unsigned)
+        .mux(Mux::Switch)
+        .choices(loop_choices())
+        .about("the stepped loop")];
+    s.extend(StepLoop::ALL.iter().map(|l| {
+        signal(
+            &format!("Amplitude_{}", words(&format!("{l:?}"))),
+            1,
+            32,
+            Kind::Float,
+        )
+        .unit(step_unit(*l))
+        .mux(Mux::Case(l.code()))
+        .about("step added to the present reference")
+    }));
+    s.push(
+        signal("Duration", 5, 16, Kind::Unsigned)
+            .scaled(1e-3, "s")
+            .about("how long the step is held (ms on the wire)"),
+    );
+    s
+}
+
+/// A compensation-table bin's signals: its index and the three channels' raw values (the
+/// header bin's exponents and bin count in the same places).
+fn compensation_bin_signals() -> Vec<Signal> {
+    vec![
+        signal("Bin", 0, 16, Kind::Unsigned).about("bin index; 65535 the header"),
+        signal("Raw0", 2, 16, Kind::Signed)
+            .about("constant channel, LSB 2^-e0 A (header: exponents e0, e1)"),
+        signal("Raw1", 4, 16, Kind::Signed)
+            .about("per-pressure channel, LSB 2^-e1 A/Pa (header: exponent e2)"),
+        signal("Raw2", 6, 16, Kind::Signed)
+            .about("per-current channel, LSB 2^-e2 A/A (header: bin count)"),
+    ]
 }
