@@ -171,10 +171,45 @@ impl Controller {
         (counts - self.cfg.sensors.pressure_zero_lsb) * self.cfg.sensors.pressure_pa_per_lsb
     }
 
-    /// The current-loop ISR body: infallible, allocation-free.
+    /// The current-loop ISR body: infallible, allocation-free. One PWM period, stage by
+    /// stage (each an always-inlined helper, so the ISR compiles to one function).
     pub fn on_current_sample(&mut self, m: &Measurements) -> Outputs {
         self.samples = self.samples.wrapping_add(1);
         self.since_command = self.since_command.saturating_add(1);
+        let (enc_event, mut theta_e) = self.track_shaft(m);
+        self.sample_pressure(m);
+
+        let mode = self.sup.mode();
+        if mode.is_active() && !self.active_last_call {
+            self.on_enter_active(mode);
+        }
+        if let Some(step) = self.step {
+            self.advance_step(step, mode);
+        }
+
+        // Pressure loop tick (before the speed loop so it uses the fresh reference).
+        self.pressure_loop_tick(mode);
+        self.advance_sweep(mode);
+        self.speed_loop_tick(mode);
+
+        let mut conditions = Conditions::default();
+        let (bridge, flux_ripple) = self.current_references(m, mode, &mut theta_e, &mut conditions);
+        let precharging = self.current_loop_step(m, theta_e, bridge, flux_ripple);
+
+        // Fault conditions of this sample.
+        self.power_stage_faults(&mut conditions);
+        self.sensor_faults(m, enc_event, &mut conditions);
+        self.operating_faults(mode, &mut conditions);
+
+        let still_on = self.supervise(conditions);
+        self.outputs(still_on, bridge, precharging)
+    }
+
+    /// Decodes the encoder's sample, learns the index's offset when it passes, moves the
+    /// speed observer on and stores the mechanical angle; returns the encoder's event and
+    /// the electrical angle θ_e. [rad]
+    #[inline(always)]
+    fn track_shaft(&mut self, m: &Measurements) -> (EncoderEvent, f32) {
         let enc_event =
             self.encoder
                 .update(m.encoder_count, m.encoder_index, m.encoder_index_count);
@@ -190,20 +225,22 @@ impl Controller {
             self.observer.update(self.encoder.position());
         }
         self.theta_m = self.encoder.mechanical_angle(m.encoder_count);
-        let mut theta_e = self.encoder.electrical_angle(m.encoder_count);
+        let theta_e = self.encoder.electrical_angle(m.encoder_count);
+        (enc_event, theta_e)
+    }
+
+    /// Scales the pressure sample and adds it to the pressure loop's running mean.
+    #[inline(always)]
+    fn sample_pressure(&mut self, m: &Measurements) {
         self.p_pa = self.pressure_pa(m.adc_pressure as f32);
         self.p_sum = self.p_sum.saturating_add(m.adc_pressure as u32);
         self.p_n += 1;
+    }
 
-        let mode = self.sup.mode();
-        if mode.is_active() && !self.active_last_call {
-            self.on_enter_active(mode);
-        }
-        if let Some(step) = self.step {
-            self.advance_step(step, mode);
-        }
-
-        // Pressure loop tick (before the speed loop so it uses the fresh reference).
+    /// On the pressure loop's tick: the mean pressure since the last tick, and in
+    /// Pressure the loop's step on it into the speed reference.
+    #[inline(always)]
+    fn pressure_loop_tick(&mut self, mode: Mode) {
         self.pressure_tick += 1;
         if self.pressure_tick >= self.d.pressure_div {
             self.pressure_tick = 0;
@@ -217,6 +254,12 @@ impl Controller {
                 self.speed_ref = self.pressure.step(mean);
             }
         }
+    }
+
+    /// Moves the feed-forward's bench sweep on into the speed setpoint; ends it (setpoint
+    /// 0) when it is done or the mode is no longer Speed.
+    #[inline(always)]
+    fn advance_sweep(&mut self, mode: Mode) {
         if let Some(sweep) = &mut self.sweep {
             match (mode, sweep.advance()) {
                 (Mode::Speed, Some(w)) => self.speed_setpoint = w,
@@ -226,7 +269,12 @@ impl Controller {
                 }
             }
         }
-        // Speed loop tick.
+    }
+
+    /// On the speed loop's tick: the measured speed, and the mode's q-current reference
+    /// (Speed, Pressure) or commissioning speed step (Calibrating).
+    #[inline(always)]
+    fn speed_loop_tick(&mut self, mode: Mode) {
         self.speed_tick += 1;
         if self.speed_tick >= self.d.speed_div {
             self.speed_tick = 0;
@@ -249,10 +297,21 @@ impl Controller {
                 _ => {}
             }
         }
+    }
 
-        // Current references by mode; calibration may hold the bridge off or force θ_e.
+    /// The current references by mode: the torque feed-forward in Speed and Pressure;
+    /// in Calibrating the sequence, which may hold the bridge off, force `theta_e` and
+    /// add its fault to `conditions`; in Disabled the boot offsets' measurement. Returns
+    /// whether the bridge switches and the feed-forward's flux ripple.
+    #[inline(always)]
+    fn current_references(
+        &mut self,
+        m: &Measurements,
+        mode: Mode,
+        theta_e: &mut f32,
+        conditions: &mut Conditions,
+    ) -> (bool, f32) {
         let mut bridge = mode.is_active();
-        let mut conditions = Conditions::default();
         self.iq_ff = 0.0;
         let mut flux_ripple = 0.0;
         match mode {
@@ -268,7 +327,7 @@ impl Controller {
             Mode::Calibrating => {
                 let (on, theta, fault) = self.calibrate(m);
                 bridge = on;
-                theta_e = theta;
+                *theta_e = theta;
                 if let Some(f) = fault {
                     conditions.set(f, true);
                 }
@@ -279,7 +338,20 @@ impl Controller {
                 }
             }
         }
+        (bridge, flux_ripple)
+    }
 
+    /// The current loop's state of this period: its step (or the commissioning's open-loop
+    /// voltage) while the bridge switches, the measured currents and DC link with centred
+    /// duties otherwise. Returns whether the period precharges the bootstrap capacitors.
+    #[inline(always)]
+    fn current_loop_step(
+        &mut self,
+        m: &Measurements,
+        theta_e: f32,
+        bridge: bool,
+        flux_ripple: f32,
+    ) -> bool {
         let omega_e = if self.forced_frame {
             0.0
         } else {
@@ -308,10 +380,14 @@ impl Controller {
                 ..CurrentLoopState::default()
             }
         };
+        precharging
+    }
 
-        // Fault conditions of this sample.
+    /// The power stage's fault conditions: phase over-current, DC-link over- and
+    /// under-voltage.
+    #[inline(always)]
+    fn power_stage_faults(&self, conditions: &mut Conditions) {
         let l = &self.cfg.limits;
-        let s = &self.cfg.sensors;
         // A NaN current counts as over-current (a fold with f32::max would drop the NaN, and
         // costs an fmaxf call per phase on the M4F).
         let over_current = self
@@ -328,6 +404,19 @@ impl Controller {
             FaultCode::DcLinkUnderVoltage,
             self.state.u_dc < l.under_voltage_v,
         );
+    }
+
+    /// The sensors' fault conditions: the pressure sensor's open wire and short, the
+    /// over-pressure it measures (when plausible), the encoder's jump and lost index.
+    #[inline(always)]
+    fn sensor_faults(
+        &self,
+        m: &Measurements,
+        enc_event: EncoderEvent,
+        conditions: &mut Conditions,
+    ) {
+        let l = &self.cfg.limits;
+        let s = &self.cfg.sensors;
         let open = m.adc_pressure < s.pressure_open_wire_lsb;
         let short = m.adc_pressure > s.pressure_short_lsb;
         conditions.set(FaultCode::PressureSensorOpenWire, open);
@@ -341,6 +430,14 @@ impl Controller {
             FaultCode::EncoderIndexLost,
             enc_event == EncoderEvent::IndexLost,
         );
+    }
+
+    /// The operation's fault conditions: over-speed, command timeout, the phase currents'
+    /// sum off zero (allowing for unmeasured offsets), and the stall monitor's update.
+    #[inline(always)]
+    fn operating_faults(&mut self, mode: Mode, conditions: &mut Conditions) {
+        let l = &self.cfg.limits;
+        let s = &self.cfg.sensors;
         conditions.set(
             FaultCode::OverSpeed,
             self.speed.speed().abs() > l.over_speed_rad_s,
@@ -371,9 +468,23 @@ impl Controller {
             sp.speed_limit_rad_s,
         );
         conditions.set(FaultCode::Stall, stalled);
+    }
 
+    /// The supervisor's check of this sample's `conditions`; notes whether the mode it
+    /// leaves is active. Returns whether the drive may still switch.
+    #[inline(always)]
+    fn supervise(&mut self, conditions: Conditions) -> bool {
         let still_on = self.sup.check(conditions);
         self.active_last_call = self.sup.mode().is_active();
+        still_on
+    }
+
+    /// The PWM outputs: the current loop's duties, or the zero vector while precharging
+    /// (counting the precharge down, the current loop reset); disabled when the bridge is
+    /// off or the supervisor tripped (the precharge re-armed; on a trip the voltages
+    /// cleared and the duties centred).
+    #[inline(always)]
+    fn outputs(&mut self, still_on: bool, bridge: bool, precharging: bool) -> Outputs {
         if still_on && bridge {
             if precharging {
                 self.precharge_left -= 1;
