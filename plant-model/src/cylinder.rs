@@ -68,6 +68,20 @@ impl Cylinder {
         )
     }
 
+    /// The spring part −k·(penetration) of the end-stop contact at `x`: what of
+    /// [`Cylinder::stop_force`] the contact stores; the rest it dissipates. [N]
+    #[inline]
+    pub fn stop_spring_force(&self, x: f64) -> f64 {
+        -self.stop_k
+            * if x > self.half_stroke_m {
+                x - self.half_stroke_m
+            } else if x < -self.half_stroke_m {
+                x + self.half_stroke_m
+            } else {
+                0.0
+            }
+    }
+
     /// End-stop contact force on the piston (pushes back inside the stroke). [N]
     #[inline]
     pub fn stop_force(&self, x: f64, v: f64) -> f64 {

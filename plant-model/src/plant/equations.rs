@@ -324,14 +324,7 @@ impl Plant {
             (vp, (piston_drive - f_fric) / c.mass_kg)
         };
         // Stop contact: force minus its spring part is what the contact dissipates.
-        let spring_part = -c.stop_k
-            * if xp > c.half_stroke_m {
-                xp - c.half_stroke_m
-            } else if xp < -c.half_stroke_m {
-                xp + c.half_stroke_m
-            } else {
-                0.0
-            };
+        let spring_part = c.stop_spring_force(xp);
         let stop = c.stop_force(xp, vp);
         PistonRates {
             d_x,

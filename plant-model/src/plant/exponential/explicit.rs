@@ -92,14 +92,7 @@ impl Plant {
                 g.f_v = (g.piston_drive - block - f_fric) / c.mass_kg;
             }
             // Stop contact: force minus its spring part is what the contact dissipates.
-            let spring_part = -c.stop_k
-                * if xp > c.half_stroke_m {
-                    xp - c.half_stroke_m
-                } else if xp < -c.half_stroke_m {
-                    xp + c.half_stroke_m
-                } else {
-                    0.0
-                };
+            let spring_part = c.stop_spring_force(xp);
             let stop = c.stop_force(xp, vp);
             g.p_visc += c.viscous * vp * vp - (stop - spring_part) * vp;
         }
