@@ -68,30 +68,25 @@ impl Cylinder {
         )
     }
 
-    /// The spring part −k·(penetration) of the end-stop contact at `x`: what of
-    /// [`Cylinder::stop_force`] the contact stores; the rest it dissipates. [N]
+    /// How far `x` lies beyond an end stop, signed as `x` (0 within the stroke). [m]
     #[inline]
-    pub fn stop_spring_force(&self, x: f64) -> f64 {
-        -self.stop_k
-            * if x > self.half_stroke_m {
-                x - self.half_stroke_m
-            } else if x < -self.half_stroke_m {
-                x + self.half_stroke_m
-            } else {
-                0.0
-            }
+    fn penetration(&self, x: f64) -> f64 {
+        if x > self.half_stroke_m {
+            x - self.half_stroke_m
+        } else if x < -self.half_stroke_m {
+            x + self.half_stroke_m
+        } else {
+            0.0
+        }
     }
 
     /// End-stop contact force on the piston (pushes back inside the stroke). [N]
     #[inline]
     pub fn stop_force(&self, x: f64, v: f64) -> f64 {
-        let over = if x > self.half_stroke_m {
-            x - self.half_stroke_m
-        } else if x < -self.half_stroke_m {
-            x + self.half_stroke_m
-        } else {
+        let over = self.penetration(x);
+        if over == 0.0 {
             return 0.0;
-        };
+        }
         let f = -self.stop_k * over - self.stop_c * v;
         // A contact only pushes.
         if over > 0.0 {
@@ -101,15 +96,21 @@ impl Cylinder {
         }
     }
 
+    /// The part of [`Cylinder::stop_force`] the contact dissipates: the force less its
+    /// spring part −k·(penetration), which the contact stores ([`Cylinder::stop_energy_j`]).
+    /// [N]
+    #[inline]
+    pub fn stop_dissipative_force(&self, x: f64, v: f64) -> f64 {
+        let over = self.penetration(x);
+        if over == 0.0 {
+            return 0.0;
+        }
+        self.stop_force(x, v) + self.stop_k * over
+    }
+
     /// Stop contact energy. [J]
     pub fn stop_energy_j(&self, x: f64) -> f64 {
-        let over = if x > self.half_stroke_m {
-            x - self.half_stroke_m
-        } else if x < -self.half_stroke_m {
-            x + self.half_stroke_m
-        } else {
-            0.0
-        };
+        let over = self.penetration(x);
         0.5 * self.stop_k * over * over
     }
 

@@ -114,7 +114,6 @@ pub fn trend_and_lines(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     #[test]
     fn lock_in_reads_amplitude_and_phase_of_a_line() {
@@ -131,6 +130,5 @@ mod tests {
         let want = Complex64::from_polar(0.3, -0.7);
         assert!((z[0][1] - want).norm() < 1e-9, "{:?}", z[0][1]);
         assert!(z[0][0].norm() < 1e-9 && z[0][2].norm() < 1e-9);
-        let _ = PI;
     }
 }

@@ -323,13 +323,12 @@ impl Plant {
         } else {
             (vp, (piston_drive - f_fric) / c.mass_kg)
         };
-        // Stop contact: force minus its spring part is what the contact dissipates.
-        let spring_part = c.stop_spring_force(xp);
-        let stop = c.stop_force(xp, vp);
+        // The stop contact's force less its spring part is what the contact dissipates.
+        let stop_loss = c.stop_dissipative_force(xp, vp);
         PistonRates {
             d_x,
             d_v,
-            p_mech: c.viscous * vp * vp + f_fric * vp - (stop - spring_part) * vp,
+            p_mech: c.viscous * vp * vp + f_fric * vp - stop_loss * vp,
         }
     }
 }

@@ -91,10 +91,9 @@ impl Plant {
                 let block = area * (p_a - p_b) - c.viscous * vp;
                 g.f_v = (g.piston_drive - block - f_fric) / c.mass_kg;
             }
-            // Stop contact: force minus its spring part is what the contact dissipates.
-            let spring_part = c.stop_spring_force(xp);
-            let stop = c.stop_force(xp, vp);
-            g.p_visc += c.viscous * vp * vp - (stop - spring_part) * vp;
+            // The stop contact's force less its spring part is what the contact dissipates.
+            let stop_loss = c.stop_dissipative_force(xp, vp);
+            g.p_visc += c.viscous * vp * vp - stop_loss * vp;
         }
         g
     }
