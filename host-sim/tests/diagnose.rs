@@ -388,8 +388,25 @@ fn two_effects_at_once_are_both_named() {
     // A leaking pump on a motor with a cogging torque: the leakage shows in the pressure's
     // relation, the cogging in the torque line at the slot order. Each judged against the
     // model extended by the other; both named, nothing else, each within 25 %.
-    let (v, _) = diagnose("pair", "pressure-step", Some(PAIR), PAIR_LOG);
+    let (v, report) = diagnose("pair", "pressure-step", Some(PAIR), PAIR_LOG);
     assert_pair_named(&v);
+    // The terminal says both, each with its evidence, as the JSON does.
+    let log = report.parent().unwrap().join("run.csv");
+    let o = eha(&["diagnose", s(&log)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    let named = v["extended"]["effects"].as_array().unwrap();
+    let label: Vec<&str> = named.iter().map(|e| e.as_str().unwrap()).collect();
+    assert!(
+        text.contains(&format!("named: {}\n", label.join(" + "))),
+        "{text}"
+    );
+    for effect in label {
+        assert!(
+            text.contains(&format!("cause: {effect} — ")),
+            "{effect}: {text}"
+        );
+    }
 }
 
 #[test]

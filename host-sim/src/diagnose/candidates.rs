@@ -198,9 +198,12 @@ pub fn reread(t: &mut Tested, fit: &Calibration, rig: &Rig) {
 }
 
 /// `v` with four decimals, or in scientific notation where that would lose it (below 10⁻²
-/// or from 10⁴ on: dead times in seconds, leakages in m³/(s·Pa), pressures in pascals).
+/// or from 10⁴ on: dead times in seconds, leakages in m³/(s·Pa), pressures in pascals); a
+/// whole number below 10⁴ (a count of pistons, a slot order, a band's end) as it is.
 pub(crate) fn short(v: f64) -> String {
-    if v != 0.0 && (v.abs() < 1e-2 || v.abs() >= 1e4) {
+    if v.fract() == 0.0 && v.abs() < 1e4 {
+        format!("{v:.0}")
+    } else if v.abs() < 1e-2 || v.abs() >= 1e4 {
         format!("{v:.3e}")
     } else {
         format!("{v:.4}")

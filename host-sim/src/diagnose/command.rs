@@ -2,6 +2,8 @@
 //! the rig (nominal or `--rig`), prints a summary, writes the contract's JSON and the report.
 
 use super::analysis::{analyse_reporting, Precision, MIN_ANALYSED_INTERVAL_S, STEPS};
+use super::candidates::short;
+use super::diagnosis::Diagnosis;
 use super::error::DiagnoseError;
 use crate::output::paths::Declared;
 use crate::output::{CliError, Outputs};
@@ -82,36 +84,54 @@ pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
     });
     bar.finish_and_clear();
     let analysis = analysis.map_err(|e| input_or_failure(e, &args.log))?;
-    let d = &analysis.diagnosis;
-    let mut text = String::new();
-    text.push_str(&format!(
+    let text = summary(&args.log, &read_as, &analysis.diagnosis);
+    let mut out = Outputs::new();
+    out.print(&text);
+    if let Some(dir) = &args.report {
+        out.folder("--report", dir, super::report::FILES, |folder| {
+            super::report::write_report(folder, &args.log, &analysis)
+        })?;
+    }
+    if let Some(path) = &args.json {
+        let value = serde_json::to_value(&analysis.diagnosis)
+            .map_err(|e| CliError::Failed(e.to_string()))?;
+        out.json("--json", path, &value)?;
+    }
+    out.commit()
+}
+
+/// The terminal's summary of diagnosis `d` of the log at `path` (`read_as`: how its rows
+/// were read): the segments, what it names, the ranking, each named effect's evidence, the
+/// validation fit per signal.
+fn summary(path: &std::path::Path, read_as: &str, d: &Diagnosis) -> String {
+    let mut text = format!(
         "{}: {} samples{read_as}; identification {:.3}–{:.3} s, validation {:.3}–{:.3} s\n",
-        args.log.display(),
+        path.display(),
         d.samples,
         d.identification_segment_s[0],
         d.identification_segment_s[1],
         d.validation_segment_s[0],
         d.validation_segment_s[1]
-    ));
-    text.push_str("rank  effect                  score  parameters\n");
+    );
+    text.push_str(&format!("named: {}\n", d.named_label()));
+    text.push_str("rank  effect                       score  parameters\n");
     for (k, c) in d.causes.iter().enumerate() {
         let params: Vec<String> = c
             .parameters
             .iter()
-            .map(|(n, v)| format!("{n}={v:.4e}"))
+            .map(|(n, v)| format!("{n}={}", short(*v)))
             .collect();
         text.push_str(&format!(
-            "{:>4}  {:<22} {:>6.3}  {}\n",
+            "{:>4}  {:<22} {:>11.3}  {}\n",
             k + 1,
             c.effect,
             c.score,
             params.join(" ")
         ));
     }
-    text.push_str(&format!(
-        "cause: {} — {}\n",
-        d.causes[0].effect, d.causes[0].evidence
-    ));
+    for c in d.named_causes() {
+        text.push_str(&format!("cause: {} — {}\n", c.effect, c.evidence_in_full()));
+    }
     text.push_str("validation fit [%]   baseline  extended\n");
     for (signal, b) in &d.baseline.fit_percent_by_signal {
         let e = d.extended.fit_percent_by_signal.get(signal).copied();
@@ -122,16 +142,5 @@ pub fn run_diagnose(rig: &Rig, args: &DiagnoseArgs) -> Result<(), CliError> {
             e.unwrap_or(f64::NAN)
         ));
     }
-    let mut out = Outputs::new();
-    out.print(&text);
-    if let Some(dir) = &args.report {
-        out.folder("--report", dir, super::report::FILES, |folder| {
-            super::report::write_report(folder, &args.log, &analysis)
-        })?;
-    }
-    if let Some(path) = &args.json {
-        let value = serde_json::to_value(d).map_err(|e| CliError::Failed(e.to_string()))?;
-        out.json("--json", path, &value)?;
-    }
-    out.commit()
+    text
 }

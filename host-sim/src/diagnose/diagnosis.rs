@@ -87,3 +87,46 @@ pub struct Gain {
     /// 100·(1 − rmse_ext / rmse_base). [%]
     pub rmse_reduction_percent: f64,
 }
+
+impl Diagnosis {
+    /// The causes of the effects the diagnosis names, in the order the extended model took
+    /// them (largest share of the gain first); the leading cause (`none`) when it names none.
+    pub fn named_causes(&self) -> Vec<&Cause> {
+        let named: Vec<&Cause> = self
+            .extended
+            .effects
+            .iter()
+            .filter_map(|e| self.causes.iter().find(|c| &c.effect == e))
+            .collect();
+        if named.is_empty() {
+            self.causes.iter().take(1).collect()
+        } else {
+            named
+        }
+    }
+
+    /// What the diagnosis names, as the terminal and the report say it: the effects joined
+    /// by ` + `, or `none`.
+    pub fn named_label(&self) -> String {
+        if self.extended.effects.is_empty() {
+            "none".into()
+        } else {
+            self.extended.effects.join(" + ")
+        }
+    }
+}
+
+impl Cause {
+    /// The evidence, with the effects the log cannot tell this one from.
+    pub fn evidence_in_full(&self) -> String {
+        if self.ambiguous_with.is_empty() {
+            self.evidence.clone()
+        } else {
+            format!(
+                "{} (the log cannot tell it from {})",
+                self.evidence,
+                self.ambiguous_with.join(", ")
+            )
+        }
+    }
+}

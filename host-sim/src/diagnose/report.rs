@@ -124,17 +124,18 @@ pub fn write_report(out: &StagedFolder, log_path: &Path, a: &Analysis) -> Result
     out.file("report.md", md.as_bytes())
 }
 
-/// The title, the leading cause with its evidence, the segments, the per-signal fit table
+/// The title, what is named and each named cause with its evidence, the segments, the per-signal fit table
 /// (baseline against extended, on the validation segment) and the pressure RMSE.
 fn summary_section(md: &mut String, log_path: &Path, d: &Diagnosis) {
-    let lead = &d.causes[0];
     let _ = writeln!(md, "# Diagnosis of `{}`\n", log_path.display());
+    let _ = writeln!(md, "**Named: `{}`**\n", d.named_label());
+    for c in d.named_causes() {
+        let _ = writeln!(md, "- **Cause: `{}`** — {}", c.effect, c.evidence_in_full());
+    }
     let _ = writeln!(
         md,
-        "**Cause: `{}`** — {}\n\n{} samples; identification segment {:.3}–{:.3} s (the fit), \
+        "\n{} samples; identification segment {:.3}–{:.3} s (the fit), \
          validation segment {:.3}–{:.3} s (the scores below; the fit never saw it).\n",
-        lead.effect,
-        lead.evidence,
         d.samples,
         d.identification_segment_s[0],
         d.identification_segment_s[1],
@@ -331,12 +332,13 @@ mod tests {
     #[test]
     fn small_and_large_parameters_keep_their_digits_in_the_ranking() {
         // A dead time of about a microsecond and a leakage of 1e-13 m³/(s·Pa) were printed
-        // as 0.0000 with four decimals.
+        // as 0.0000 with four decimals; a count of pistons as 9.0000.
         assert_eq!(short(1.063e-6), "1.063e-6");
         assert_eq!(short(9.886e-13), "9.886e-13");
         assert_eq!(short(4.599e6), "4.599e6");
         assert_eq!(short(0.0397), "0.0397");
         assert_eq!(short(-3.0364), "-3.0364");
-        assert_eq!(short(0.0), "0.0000");
+        assert_eq!(short(72.0), "72");
+        assert_eq!(short(0.0), "0");
     }
 }
