@@ -79,6 +79,11 @@ struct SeedRun {
 
 /// Generates, reads back and diagnoses one seed.
 fn run_seed(seed: u64) -> SeedRun {
+    run_seed_as(seed, |_| {})
+}
+
+/// [`run_seed`] with the log read back changed by `edit` before it is diagnosed.
+fn run_seed_as(seed: u64, edit: impl Fn(&mut bench_log::BenchLog)) -> SeedRun {
     let (path, truth) = match generate(seed, &log_dir()) {
         Ok(g) => g,
         Err(e) => {
@@ -91,7 +96,8 @@ fn run_seed(seed: u64) -> SeedRun {
     };
     let said = bench_log::read(&path)
         .map_err(|e| format!("reading back the generated log: {e}"))
-        .and_then(|log| {
+        .and_then(|mut log| {
+            edit(&mut log);
             diagnose(&log, &Rig::nominal()).map_err(|e| format!("diagnose failed: {e}"))
         })
         .and_then(|d| serde_json::to_value(&d).map_err(|e| format!("to JSON: {e}")))
@@ -373,6 +379,47 @@ fn air_on_a_stroke_is_read_from_the_position() {
         );
     }
     all_right(&AIR_ON_A_STROKE_SEEDS);
+}
+
+/// A shaft friction (0.195 N·m Coulomb, 0.266 N·m breakaway) on a 10 kHz sine test whose
+/// release has a second, shallower basin near half the Coulomb torque, which a search from
+/// the grid's best point alone reached or not by the log's last bits.
+const SHAFT_FRICTION_BASIN_SEED: u64 = 25;
+
+/// The shaft friction read in its deeper basin, within the judge's standard, on the log
+/// as generated (its row times sums of PWM periods) and on the same log with each row's
+/// time recounted as a whole number of PWM periods over the PWM frequency (the same
+/// instants within 10⁻¹⁰ s). From the grid's best point alone both read 0.100 N·m.
+#[test]
+fn a_shaft_friction_is_read_in_its_deeper_basin() {
+    let seed = SHAFT_FRICTION_BASIN_SEED;
+    let t = outline(seed);
+    assert!(
+        t.effects.iter().any(|e| e.name == "shaft_friction"),
+        "seed {seed} hides no shaft friction"
+    );
+    let pwm_hz = Rig::nominal().inverter.pwm_frequency_hz;
+    let recount = |log: &mut bench_log::BenchLog| {
+        for t in &mut log.t_s {
+            let periods = (*t * pwm_hz).round();
+            assert!(
+                (periods / pwm_hz - *t).abs() < 1e-10,
+                "row at {t} s off the grid"
+            );
+            *t = periods / pwm_hz;
+        }
+    };
+    let runs = [run_seed(seed), run_seed_as(seed, recount)];
+    let failed = judge(&runs);
+    assert!(
+        failed.is_empty(),
+        "{}",
+        failed
+            .iter()
+            .map(|(_, a)| a.as_str())
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
 }
 
 /// Freely drawn pressure tests whose absorber's precharge (4.23–4.40 MPa) lies above every

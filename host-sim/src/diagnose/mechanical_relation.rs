@@ -17,6 +17,11 @@ pub const SHAFT_COULOMB_BAND_NM: f64 = 0.02;
 /// Length of a speed shooting window. [s]
 pub const SPEED_WINDOW_S: f64 = 0.05;
 
+/// Points of the shaft friction's grid fitted besides its best one: the released fit has a
+/// second, shallower basin near half the Coulomb torque that the grid, scoring each point
+/// with the other parameters held, may judge the deeper one.
+const SHAFT_FRICTION_BASINS: usize = 2;
+
 /// Index of each mechanical parameter in the search vector.
 pub mod mech {
     /// Magnet flux linkage (the torque constant's scale).
@@ -212,6 +217,14 @@ impl Relation for MechanicalRelation<'_> {
 
     fn released(&self, release: Release) -> Option<(usize, Vec<f64>)> {
         (release == Release::ShaftFriction).then(|| (mech::COULOMB, vec![0.02, 0.1, 0.3, 0.8]))
+    }
+
+    fn grid_basins(&self, release: Release) -> usize {
+        if release == Release::ShaftFriction {
+            SHAFT_FRICTION_BASINS
+        } else {
+            0
+        }
     }
 
     fn residuals(&self, values: &[f64], rows: &[Range<usize>]) -> Vec<f64> {
