@@ -98,8 +98,10 @@ struct Obs {
     measured: [Complex64; 2],
     model: [Complex64; 2],
     var: [f64; 2],
-    /// The noise floors alone, which weigh the scale's estimate (weights from the measured
-    /// lines would bias it). [A²]
+    /// The noise floors, and on q the variance of the outer loops' corrections
+    /// ([`loop_lines`]), which weigh the scale's estimate (weights from the measured lines
+    /// would bias it; the corrections' come from the shaft's oscillation, not from the
+    /// current lines). [A²]
     floor: [f64; 2],
 }
 
@@ -119,7 +121,10 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
             let [y_d, y_q, model_var] = loop_lines(w, o, rig)?;
             let floor_d = w.floor(order, candidates, |x| x.id);
             let floor_q = w.floor(order, candidates, |x| x.iq);
-            // The loops' model is Table 1's: its uncertainty on top of the noise floor.
+            // The loops' model is Table 1's: its uncertainty on top of the noise floor. The
+            // q line's corrections for the speed loop and the back-EMF carry theirs into the
+            // scale's weights too: at holding speed the outer loops act on the q current,
+            // and its model is the less certain of the two.
             let tol = |z: Complex64| 0.5 * (LOOP_TOLERANCE * z.norm()).powi(2);
             let (var_d, var_q) = (floor_d + tol(y_d), floor_q + tol(y_q) + model_var.re);
             if !(var_d.is_finite() && var_q.is_finite()) {
@@ -140,7 +145,7 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
                 measured,
                 model,
                 var: [var_d, var_q],
-                floor: [floor_d, floor_q],
+                floor: [floor_d, floor_q + model_var.re],
             })
         })
         .collect()
@@ -215,7 +220,7 @@ fn explained(obs: &[Obs], scale: f64, weight: fn(&Obs, usize) -> f64) -> f64 {
 }
 
 /// The weighted least-squares scale of the model lines onto the measured ones, and the
-/// line power it explains weighed by the noise floors alone (which choose the fade band)
+/// line power it explains weighed by the noise floors (which choose the fade band)
 /// and with the loops' uncertainty (the reported Λ); `None` when no model line is there or
 /// the scale would pass `max_scale`.
 fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64, f64)> {
