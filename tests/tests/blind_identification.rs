@@ -79,33 +79,40 @@ struct SeedRun {
 
 /// Generates, reads back and diagnoses one seed.
 fn run_seed(seed: u64) -> SeedRun {
-    run_seed_as(seed, |_| {})
+    run_seed_as(seed, &[&|_| {}]).remove(0)
 }
 
-/// [`run_seed`] with the log read back changed by `edit` before it is diagnosed.
-fn run_seed_as(seed: u64, edit: impl Fn(&mut bench_log::BenchLog)) -> SeedRun {
-    let (path, truth) = match generate(seed, &log_dir()) {
-        Ok(g) => g,
-        Err(e) => {
-            return SeedRun {
-                seed,
-                truth: outline(seed),
-                said: Err(format!("the generator failed: {e}")),
-            }
-        }
-    };
-    let said = bench_log::read(&path)
-        .map_err(|e| format!("reading back the generated log: {e}"))
-        .and_then(|mut log| {
-            edit(&mut log);
-            diagnose(&log, &Rig::nominal()).map_err(|e| format!("diagnose failed: {e}"))
+/// Generates and reads back one seed's log once, then diagnoses it as changed by each of
+/// `edits` in turn: one run per edit.
+fn run_seed_as(seed: u64, edits: &[&dyn Fn(&mut bench_log::BenchLog)]) -> Vec<SeedRun> {
+    let read = generate(seed, &log_dir())
+        .map_err(|e| format!("the generator failed: {e}"))
+        .and_then(|(path, truth)| {
+            let log = bench_log::read(&path)
+                .map_err(|e| format!("reading back the generated log: {e}"))?;
+            Ok((log, truth))
+        });
+    edits
+        .iter()
+        .map(|edit| {
+            let (truth, said) = match &read {
+                Ok((log, truth)) => {
+                    let mut log = log.clone();
+                    edit(&mut log);
+                    let said = diagnose(&log, &Rig::nominal())
+                        .map_err(|e| format!("diagnose failed: {e}"))
+                        .and_then(|d| serde_json::to_value(&d).map_err(|e| format!("to JSON: {e}")))
+                        .and_then(|json| read_said(&json));
+                    (truth.clone(), said)
+                }
+                Err(e) => (outline(seed), Err(e.clone())),
+            };
+            let run = SeedRun { seed, truth, said };
+            // Each run as soon as it is judged: a long run shows its results as they come.
+            eprintln!("{}", row(&run).0);
+            run
         })
-        .and_then(|d| serde_json::to_value(&d).map_err(|e| format!("to JSON: {e}")))
-        .and_then(|json| read_said(&json));
-    let run = SeedRun { seed, truth, said };
-    // Each seed as soon as it is judged: a long run shows its results as they come.
-    eprintln!("{}", row(&run).0);
-    run
+        .collect()
 }
 
 /// The hidden effects as the judge takes them.
@@ -409,17 +416,8 @@ fn a_shaft_friction_is_read_in_its_deeper_basin() {
             *t = periods / pwm_hz;
         }
     };
-    let runs = [run_seed(seed), run_seed_as(seed, recount)];
-    let failed = judge(&runs);
-    assert!(
-        failed.is_empty(),
-        "{}",
-        failed
-            .iter()
-            .map(|(_, a)| a.as_str())
-            .collect::<Vec<_>>()
-            .join("\n")
-    );
+    let runs = run_seed_as(seed, &[&|_| {}, &recount]);
+    assert_none_failed(&judge(&runs));
 }
 
 /// Freely drawn pressure tests whose absorber's precharge (4.23–4.40 MPa) lies above every
@@ -430,7 +428,11 @@ const PRECHARGE_ABOVE_THE_TEST_SEEDS: [u64; 3] = [4_302_112, 4_305_405, 4_318_30
 
 /// Every one of `seeds` judged right, or the judge's account of each that is not.
 fn all_right(seeds: &[u64]) {
-    let failed = run_and_judge(seeds);
+    assert_none_failed(&run_and_judge(seeds));
+}
+
+/// No run in `failed` (the judge's failed seeds with their accounts), or the accounts.
+fn assert_none_failed(failed: &[(u64, String)]) {
     assert!(
         failed.is_empty(),
         "{}",

@@ -98,11 +98,11 @@ struct Obs {
     measured: [Complex64; 2],
     model: [Complex64; 2],
     var: [f64; 2],
-    /// The noise floors, and on q the variance of the outer loops' corrections
-    /// ([`loop_lines`]), which weigh the scale's estimate (weights from the measured lines
-    /// would bias it; the corrections' come from the shaft's oscillation, not from the
-    /// current lines). [A²]
-    floor: [f64; 2],
+    /// The variances that weigh the scale's estimate and choose the fade band: the noise
+    /// floors, and on q the variance of the outer loops' corrections ([`loop_lines`]).
+    /// Weights from the measured lines would bias the scale; the corrections' come from the
+    /// shaft's oscillation, not from the current lines. [A²]
+    scale_var: [f64; 2],
 }
 
 /// The index of `band` in [`BANDS_A`].
@@ -145,7 +145,7 @@ fn observations(lines: &[&WindowLines], rig: &Rig, band: f64, candidates: &[u32]
                 measured,
                 model,
                 var: [var_d, var_q],
-                floor: [floor_d, floor_q + model_var.re],
+                scale_var: [floor_d, floor_q + model_var.re],
             })
         })
         .collect()
@@ -220,15 +220,15 @@ fn explained(obs: &[Obs], scale: f64, weight: fn(&Obs, usize) -> f64) -> f64 {
 }
 
 /// The weighted least-squares scale of the model lines onto the measured ones, and the
-/// line power it explains weighed by the noise floors (which choose the fade band)
+/// line power it explains weighed by the scale's variances (which choose the fade band)
 /// and with the loops' uncertainty (the reported Λ); `None` when no model line is there or
 /// the scale would pass `max_scale`.
 fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64, f64)> {
     let (mut num, mut den) = (0.0, 0.0);
     for o in obs {
         for a in 0..2 {
-            num += (o.model[a].conj() * o.measured[a]).re / o.floor[a];
-            den += o.model[a].norm_sqr() / o.floor[a];
+            num += (o.model[a].conj() * o.measured[a]).re / o.scale_var[a];
+            den += o.model[a].norm_sqr() / o.scale_var[a];
         }
     }
     if den <= 0.0 {
@@ -240,7 +240,7 @@ fn solve(obs: &[Obs], max_scale: f64) -> Option<(f64, f64, f64)> {
     }
     Some((
         scale,
-        explained(obs, scale, |o, a| o.floor[a]).max(0.0),
+        explained(obs, scale, |o, a| o.scale_var[a]).max(0.0),
         explained(obs, scale, |o, a| o.var[a]).max(0.0),
     ))
 }
@@ -288,13 +288,13 @@ mod tests {
                 measured: [c(3.0), c(3.0)],
                 model: [c(1.0), c(1.0)],
                 var: [1.0, 1.0],
-                floor: [1.0, 1.0],
+                scale_var: [1.0, 1.0],
             },
             Obs {
                 measured: [c(6.0), c(6.0)],
                 model: [c(2.0), c(2.0)],
                 var: [1.0, 1.0],
-                floor: [1.0, 1.0],
+                scale_var: [1.0, 1.0],
             },
         ];
         let (scale, lambda, _) = solve(&obs, 10.0).unwrap();

@@ -124,8 +124,9 @@ pub fn write_report(out: &StagedFolder, log_path: &Path, a: &Analysis) -> Result
     out.file("report.md", md.as_bytes())
 }
 
-/// The title, what is named and each named cause with its evidence, the segments, the per-signal fit table
-/// (baseline against extended, on the validation segment) and the pressure RMSE.
+/// The title, what is named and each named cause with its evidence, the segments, the
+/// per-signal fit table (baseline against extended, on the validation segment) and the
+/// pressure RMSE.
 fn summary_section(md: &mut String, log_path: &Path, d: &Diagnosis) {
     let _ = writeln!(md, "# Diagnosis of `{}`\n", log_path.display());
     let _ = writeln!(md, "**Named: `{}`**\n", d.named_label());
